@@ -1,0 +1,76 @@
+"""The transport abstraction: what every servo bus backend offers the streamer.
+
+Modelled on python-can's BusABC: backends differ only below this line.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Iterable, Mapping
+
+
+class BusError(Exception):
+    """A bus operation failed.
+
+    result_code: the SDK's communication result (COMM_* value), or None.
+    servo_id: the servo concerned, or None for a whole-bus failure.
+    status_error: the servo's status error bits (hardware error byte), 0 when none.
+    """
+
+    def __init__(self, message: str, *, result_code: int | None = None, servo_id: int | None = None,
+                 status_error: int = 0) -> None:
+        super().__init__(message)
+        self.result_code = result_code
+        self.servo_id = servo_id
+        self.status_error = status_error
+
+
+class PortError(BusError):
+    """The serial port cannot be opened, or disappeared."""
+
+
+class ServoTimeout(BusError):
+    """A servo did not answer (after the bounded retries)."""
+
+
+class ServoStatusError(BusError):
+    """A servo answered with error bits set (overload, overheating, input voltage ...)."""
+
+
+class Bus(ABC):
+    """A chain of servos on one serial bus.
+
+    Positions are raw ticks; calibration (angles <-> ticks) lives in the robot room.
+    """
+
+    @abstractmethod
+    def open(self) -> None: ...
+
+    @abstractmethod
+    def close(self) -> None: ...
+
+    @abstractmethod
+    def ping(self, servo_id: int) -> bool:
+        """True if the servo answers (after bounded retries)."""
+
+    def scan(self, ids: Iterable[int]) -> list[int]:
+        """The ids among ``ids`` that answer a ping."""
+        return [i for i in ids if self.ping(i)]
+
+    @abstractmethod
+    def set_torque(self, ids: Iterable[int], enabled: bool) -> None: ...
+
+    @abstractmethod
+    def write_goal_ticks(self, goals: Mapping[int, int]) -> None:
+        """Write every goal position of one frame in one sync-write packet."""
+
+    @abstractmethod
+    def read_present_ticks(self, ids: Iterable[int]) -> dict[int, int]:
+        """Present positions (sync read where the protocol has it); reads retry a bounded number of times."""
+
+    def __enter__(self) -> "Bus":
+        self.open()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

@@ -1,0 +1,156 @@
+"""The Trajectory type: joint angles and root position over time, and its CSV/NPZ files.
+
+Every later room reads trajectories, so the file contract is fixed here:
+CSV with a header row ``t_s, <joint>_deg x 6, root_x_m, root_y_m``; angles are
+flexion-positive degrees in files and radians in memory.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+WALKING_JOINTS = (
+    "hip_pitch_left",
+    "knee_pitch_left",
+    "ankle_pitch_left",
+    "hip_pitch_right",
+    "knee_pitch_right",
+    "ankle_pitch_right",
+)
+CSV_COLUMNS = ("t_s",) + tuple(f"{name}_deg" for name in WALKING_JOINTS) + ("root_x_m", "root_y_m")
+
+
+class TrajectoryFileError(ValueError):
+    """A trajectory file cannot be read; the message names the file and what is wrong."""
+
+
+@dataclass(frozen=True)
+class HeelStrike:
+    """One heel strike: when, which leg, and where the heel touched the ground (world x, metres)."""
+
+    t_s: float
+    leg: str  # "left" or "right"
+    x_m: float
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Sampled walking motion.
+
+    t_s: (N,) sample times in seconds, increasing.
+    angles_rad: (N, 6) joint angles in radians, columns in WALKING_JOINTS order, flexion positive.
+    root_m: (N, 2) the hip point in the world (x forward, y up; ground at y = 0), metres.
+    heel_strikes: the planned heel-strike events, in time order.
+    """
+
+    t_s: np.ndarray
+    angles_rad: np.ndarray
+    root_m: np.ndarray
+    heel_strikes: tuple[HeelStrike, ...] = field(default_factory=tuple)
+
+    def __post_init__(self) -> None:
+        n = len(self.t_s)
+        if self.angles_rad.shape != (n, len(WALKING_JOINTS)):
+            raise ValueError(f"angles_rad must have shape ({n}, {len(WALKING_JOINTS)}), got {self.angles_rad.shape}")
+        if self.root_m.shape != (n, 2):
+            raise ValueError(f"root_m must have shape ({n}, 2), got {self.root_m.shape}")
+
+    def __len__(self) -> int:
+        return len(self.t_s)
+
+    @property
+    def angles_deg(self) -> np.ndarray:
+        return np.degrees(self.angles_rad)
+
+    def joint_deg(self, name: str) -> np.ndarray:
+        """Angle of one walking joint over time, in degrees."""
+        return np.degrees(self.angles_rad[:, WALKING_JOINTS.index(name)])
+
+    def save(self, path: str | Path) -> None:
+        """Write to ``.csv`` or ``.npz`` (chosen by the suffix)."""
+        path = Path(path)
+        if path.suffix == ".npz":
+            strikes = np.array([(h.t_s, 0 if h.leg == "left" else 1, h.x_m) for h in self.heel_strikes]).reshape(-1, 3)
+            np.savez(path, t_s=self.t_s, angles_deg=self.angles_deg, root_m=self.root_m,
+                     heel_strikes=strikes, joints=np.array(WALKING_JOINTS))
+        elif path.suffix == ".csv":
+            table = np.column_stack([self.t_s, self.angles_deg, self.root_m])
+            with open(path, "w", newline="") as f:
+                f.write(",".join(CSV_COLUMNS) + "\n")
+                np.savetxt(f, table, delimiter=",", fmt="%.9g")
+        else:
+            raise TrajectoryFileError(f"{path}: unknown trajectory format {path.suffix!r} (allowed: .csv, .npz)")
+
+    @classmethod
+    def load(cls, path: str | Path) -> "Trajectory":
+        """Read a ``.csv`` or ``.npz`` trajectory; raise TrajectoryFileError with a one-line reason."""
+        path = Path(path)
+        if not path.is_file():
+            raise TrajectoryFileError(f"{path}: no such file")
+        if path.suffix == ".npz":
+            return _load_npz(path)
+        if path.suffix == ".csv":
+            return _load_csv(path)
+        raise TrajectoryFileError(f"{path}: unknown trajectory format {path.suffix!r} (allowed: .csv, .npz)")
+
+
+def _from_table(path: Path, t: np.ndarray, angles_deg: np.ndarray, root: np.ndarray, strikes=()) -> Trajectory:
+    if len(t) < 2:
+        raise TrajectoryFileError(f"{path}: needs at least 2 samples, found {len(t)}")
+    for name, values in (("t_s", t), ("joint angles", angles_deg), ("root", root)):
+        if not np.all(np.isfinite(values)):
+            raise TrajectoryFileError(f"{path}: column {name} holds a value that is not a finite number")
+    if np.any(np.diff(t) <= 0):
+        i = int(np.argmax(np.diff(t) <= 0)) + 1
+        raise TrajectoryFileError(f"{path}: t_s must increase, but row {i + 1} has t_s={t[i]!r} after {t[i - 1]!r}")
+    return Trajectory(t.astype(float), np.radians(angles_deg.astype(float)), root.astype(float), tuple(strikes))
+
+
+def _load_csv(path: Path) -> Trajectory:
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise TrajectoryFileError(f"{path}: cannot read ({exc})") from None
+    rows = list(csv.reader(io.StringIO(text)))
+    if not rows:
+        raise TrajectoryFileError(f"{path}: empty file (expected a header row {','.join(CSV_COLUMNS)})")
+    header = [h.strip() for h in rows[0]]
+    missing = [c for c in CSV_COLUMNS if c not in header]
+    if missing:
+        raise TrajectoryFileError(f"{path}: missing column {missing[0]!r} (header must hold {','.join(CSV_COLUMNS)})")
+    index = [header.index(c) for c in CSV_COLUMNS]
+    data = []
+    for line_no, row in enumerate(rows[1:], start=2):
+        if not row or all(not cell.strip() for cell in row):
+            continue
+        if len(row) != len(header):
+            raise TrajectoryFileError(f"{path}: line {line_no} has {len(row)} fields, header has {len(header)} (truncated file?)")
+        try:
+            data.append([float(row[i]) for i in index])
+        except ValueError:
+            raise TrajectoryFileError(f"{path}: line {line_no} holds a value that is not a number") from None
+    table = np.array(data, dtype=float).reshape(-1, len(CSV_COLUMNS))
+    return _from_table(path, table[:, 0], table[:, 1:7], table[:, 7:9])
+
+
+def _load_npz(path: Path) -> Trajectory:
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            missing = [k for k in ("t_s", "angles_deg", "root_m") if k not in z.files]
+            if missing:
+                raise TrajectoryFileError(f"{path}: missing array {missing[0]!r} (needs t_s, angles_deg, root_m)")
+            t, ang, root = z["t_s"], z["angles_deg"], z["root_m"]
+            raw = z["heel_strikes"] if "heel_strikes" in z.files else np.zeros((0, 3))
+    except TrajectoryFileError:
+        raise
+    except Exception as exc:  # zipfile/ValueError/EOFError on a truncated or foreign file
+        raise TrajectoryFileError(f"{path}: not a readable .npz trajectory ({type(exc).__name__}: {exc})") from None
+    if ang.ndim != 2 or ang.shape[1] != 6 or ang.shape[0] != len(t) or root.shape != (len(t), 2):
+        raise TrajectoryFileError(f"{path}: arrays have inconsistent shapes t_s{t.shape} angles_deg{ang.shape} root_m{root.shape}")
+    strikes = [HeelStrike(float(a), "left" if int(b) == 0 else "right", float(c)) for a, b, c in raw.reshape(-1, 3)]
+    return _from_table(path, t, ang, root, strikes)

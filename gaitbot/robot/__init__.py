@@ -1,0 +1,1 @@
+"""The robot room: robot description from config, servo models, calibration and limits."""
