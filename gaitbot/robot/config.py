@@ -1,0 +1,478 @@
+"""Robot description from a TOML file: geometry, gait settings, bus and joints, validated.
+
+Why so strict: a config error found on the bench means a servo driven into its end stop or a
+mirror-mounted knee bending backwards. Every value is checked when the file is loaded and the
+first problem is reported as ONE line naming the file, the field and what is allowed::
+
+    config/xl430-biped.toml: joints.knee_pitch_left.min_deg: 120.0 is above max_deg 110.0
+
+Unknown keys are errors too: they are usually typos (``max_velocity_dsp``) that would otherwise
+silently fall back to nothing.
+
+Checks that need another room (whether the bus can carry ``gait.rate_hz`` frames at
+``bus.baudrate``: ``gaitbot.bus.budget``) are passed in by the caller through ``extra_checks``,
+because this module imports only from rooms to its left (gait -> robot -> bus -> stream).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import re
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from gaitbot.gait.trajectory import WALKING_JOINTS
+from gaitbot.robot.calibration import angle_rad_to_ticks
+from gaitbot.robot.servo_models import SERVO_MODELS, ServoModel
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib  # type: ignore[no-redef]
+
+DEFAULT_ROBOT = "xl430-biped"
+BACKENDS = ("dynamixel", "feetech")
+DYNAMIXEL_PROTOCOLS = (1.0, 2.0)
+# Highest usable id per backend; 254 is the broadcast id on both, Dynamixel reserves 253 too.
+MAX_SERVO_ID = {"dynamixel": 252, "feetech": 253}
+
+
+class ConfigError(ValueError):
+    """A robot config is unusable. The message is one line: ``<file>: <field>: <what is wrong>``.
+
+    ``path``, ``field`` and ``reason`` hold the three parts for callers that want them apart.
+    Other modules that check a loaded config (the bus budget) build theirs with ``ConfigError(path,
+    field, reason)`` so every config complaint looks the same.
+    """
+
+    def __init__(self, path: str | Path, field: str, reason: str) -> None:
+        self.path = str(path)
+        self.field = field
+        self.reason = " ".join(str(reason).split())  # one line, whatever the reason held
+        super().__init__(f"{self.path}: {field}: {self.reason}")
+
+
+# ---------------------------------------------------------------------------------------------
+# The data classes
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Leg dimensions in metres: hip-knee, knee-ankle, foot length, distance between the hip
+    joints, and ankle axis above the sole."""
+
+    thigh_m: float
+    shank_m: float
+    foot_m: float
+    hip_width_m: float
+    ankle_height_m: float = 0.0
+
+
+@dataclass(frozen=True)
+class GaitSettings:
+    """Walking parameters: cycle period (s), longest step (m), swing-foot clearance (m), frame rate (Hz)."""
+
+    cycle_s: float
+    max_step_m: float
+    clearance_m: float
+    rate_hz: float
+
+
+@dataclass(frozen=True)
+class BusSettings:
+    """The serial bus. ``protocol`` is the Dynamixel protocol version (None for Feetech, which has one)."""
+
+    backend: str
+    protocol: float | None
+    port: str
+    baudrate: int
+    torque_off_on_exit: bool = False
+
+
+@dataclass(frozen=True)
+class JointConfig:
+    """One servo joint.
+
+    Angles are flexion positive. ``zero_tick`` is the tick at angle 0; ``direction`` is +1 or -1
+    (-1 for mirror-mounted servos). ``hold_deg`` is set only for non-walking joints, which are
+    held at that angle while walking.
+    """
+
+    name: str
+    id: int
+    model: ServoModel
+    zero_tick: int
+    direction: int
+    min_deg: float
+    max_deg: float
+    max_velocity_dps: float
+    max_acceleration_dps2: float
+    hold_deg: float | None = None
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    """A whole robot: joints are the walking joints in WALKING_JOINTS order, then the held joints."""
+
+    path: Path
+    name: str
+    geometry: Geometry
+    gait: GaitSettings
+    bus: BusSettings
+    joints: tuple[JointConfig, ...]
+
+    @property
+    def walking_joints(self) -> tuple[JointConfig, ...]:
+        return self.joints[: len(WALKING_JOINTS)]
+
+    @property
+    def held_joints(self) -> tuple[JointConfig, ...]:
+        return self.joints[len(WALKING_JOINTS):]
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        return tuple(j.name for j in self.joints)
+
+    @property
+    def ids(self) -> tuple[int, ...]:
+        """Servo ids in joint order."""
+        return tuple(j.id for j in self.joints)
+
+    def joint(self, name: str) -> JointConfig:
+        for j in self.joints:
+            if j.name == name:
+                return j
+        raise KeyError(f"{self.path}: no joint {name!r} (joints: {', '.join(self.joint_names)})")
+
+
+# A check run on a loaded config; raises ConfigError. See load_robot_config(extra_checks=...).
+ConfigCheck = Callable[[RobotConfig], None]
+
+
+# ---------------------------------------------------------------------------------------------
+# Finding the shipped configs
+
+
+def shipped_config_dirs() -> list[Path]:
+    """Directories holding the shipped robot files: the wheel's ``gaitbot/_config`` first (pyproject
+    force-includes the top-level ``config/`` there), then ``<repo>/config`` for source checkouts."""
+    dirs: list[Path] = []
+    try:
+        packaged = resources.files("gaitbot") / "_config"
+        if isinstance(packaged, Path) and packaged.is_dir():
+            dirs.append(packaged)
+    except (ModuleNotFoundError, OSError):  # pragma: no cover - gaitbot is importable if we run
+        pass
+    source = Path(__file__).resolve().parents[2] / "config"
+    if source.is_dir():
+        dirs.append(source)
+    return dirs
+
+
+def shipped_config_names() -> list[str]:
+    """Names of the shipped robots (file stems), sorted."""
+    return sorted({p.stem for d in shipped_config_dirs() for p in d.glob("*.toml")})
+
+
+def resolve_config(name_or_path: str | Path) -> Path:
+    """A config file from a path, or from the bare name of a shipped robot (``xl430-biped``).
+
+    An existing file wins; otherwise a bare name (no directory part) is looked up among the shipped
+    configs. Raises ConfigError listing the shipped names when neither exists.
+    """
+    path = Path(name_or_path)
+    if path.is_file():
+        return path
+    text = str(name_or_path)
+    if len(path.parts) == 1:
+        stem = text[:-5] if text.endswith(".toml") else text
+        for directory in shipped_config_dirs():
+            candidate = directory / f"{stem}.toml"
+            if candidate.is_file():
+                return candidate
+    shipped = ", ".join(shipped_config_names()) or "none found"
+    raise ConfigError(text, "file", f"no such file, and not the name of a shipped robot (shipped: {shipped})")
+
+
+def default_config_path() -> Path:
+    """The built-in default robot's file (xl430-biped)."""
+    return resolve_config(DEFAULT_ROBOT)
+
+
+# ---------------------------------------------------------------------------------------------
+# Loading
+
+
+def load_robot_config(path: str | Path, *, extra_checks: Iterable[ConfigCheck] = ()) -> RobotConfig:
+    """Read and validate a robot config; raise ConfigError (one line) on the first problem.
+
+    ``extra_checks`` are run on the validated config, in order; this is the hook for checks that
+    live in rooms to the right of this one, e.g. the integrator passes
+    ``gaitbot.bus.budget``'s check that the bus can carry ``gait.rate_hz`` frames per second.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise ConfigError(path, "file", f"cannot read ({reason})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        message = str(exc)
+        match = re.search(r"\(at line (\d+), column (\d+)\)", message)
+        where = f"line {match.group(1)}" if match else "file"
+        reason = re.sub(r"\s*\(at line \d+, column \d+\)", "", message)
+        if match:
+            reason += f" (column {match.group(2)})"
+        raise ConfigError(path, where, f"TOML syntax error: {reason}") from None
+    config = _Reader(path).robot(data)
+    for check in extra_checks:
+        check(config)
+    return config
+
+
+_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints")
+_ROBOT_KEYS = ("name",)
+_GEOMETRY_KEYS = ("thigh_m", "shank_m", "foot_m", "hip_width_m", "ankle_height_m")
+_GAIT_KEYS = ("cycle_s", "max_step_m", "clearance_m", "rate_hz")
+_BUS_KEYS = ("backend", "protocol", "port", "baudrate", "torque_off_on_exit")
+_JOINT_KEYS = ("id", "model", "zero_tick", "direction", "min_deg", "max_deg", "max_velocity_dps",
+               "max_acceleration_dps2", "hold_deg")
+
+
+class _Reader:
+    """Field-by-field reading with the field's dotted name at hand for the error message."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def fail(self, field: str, reason: str) -> ConfigError:
+        return ConfigError(self.path, field, reason)
+
+    # -- generic pieces -----------------------------------------------------------------------
+
+    def table(self, parent: dict, key: str, field: str, allowed: tuple[str, ...]) -> dict:
+        if key not in parent:
+            raise self.fail(field, f"missing section [{field}]")
+        value = parent[key]
+        if not isinstance(value, dict):
+            raise self.fail(field, f"must be a table [{field}], got {_kind(value)}")
+        self.no_unknown_keys(value, field, allowed)
+        return value
+
+    def no_unknown_keys(self, table: dict, field: str, allowed: tuple[str, ...]) -> None:
+        for key in table:
+            if key not in allowed:
+                close = difflib.get_close_matches(key, allowed, n=1)
+                hint = f"did you mean {close[0]!r}? " if close else ""
+                prefix = f"{field}.{key}" if field else key
+                raise self.fail(prefix, f"unknown key ({hint}allowed: {', '.join(allowed)})")
+
+    def require(self, table: dict, key: str, field: str, what: str):
+        if key not in table:
+            raise self.fail(f"{field}.{key}", f"missing (expected {what})")
+        return table[key]
+
+    def number(self, table: dict, key: str, field: str, *, positive: bool = False,
+               non_negative: bool = False, default: float | None = None) -> float:
+        what = "a positive number" if positive else "a number >= 0" if non_negative else "a number"
+        if key not in table and default is not None:
+            return default
+        value = self.require(table, key, field, what)
+        name = f"{field}.{key}"
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(name, f"must be {what}, got {_kind(value)}")
+        if not math.isfinite(value):
+            raise self.fail(name, f"must be a finite number, got {value}")
+        if positive and value <= 0:
+            raise self.fail(name, f"must be a positive number, got {value}")
+        if non_negative and value < 0:
+            raise self.fail(name, f"must be >= 0, got {value}")
+        return float(value)
+
+    def integer(self, table: dict, key: str, field: str, what: str = "an integer"):
+        value = self.require(table, key, field, what)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise self.fail(f"{field}.{key}", f"must be {what}, got {_kind(value)}")
+        return value
+
+    def string(self, table: dict, key: str, field: str, what: str = "a non-empty string") -> str:
+        value = self.require(table, key, field, what)
+        if not isinstance(value, str) or not value.strip():
+            raise self.fail(f"{field}.{key}", f"must be {what}, got {_kind(value)}")
+        return value
+
+    # -- sections -----------------------------------------------------------------------------
+
+    def robot(self, data: dict) -> RobotConfig:
+        self.no_unknown_keys(data, "", _TOP_KEYS)
+        robot = self.table(data, "robot", "robot", _ROBOT_KEYS)
+        name = self.string(robot, "name", "robot")
+        geometry = self.geometry(self.table(data, "geometry", "geometry", _GEOMETRY_KEYS))
+        gait = self.gait(self.table(data, "gait", "gait", _GAIT_KEYS))
+        bus = self.bus(self.table(data, "bus", "bus", _BUS_KEYS))
+        joints = self.joints(data, bus)
+        return RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints)
+
+    def geometry(self, t: dict) -> Geometry:
+        f = "geometry"
+        return Geometry(
+            thigh_m=self.number(t, "thigh_m", f, positive=True),
+            shank_m=self.number(t, "shank_m", f, positive=True),
+            foot_m=self.number(t, "foot_m", f, positive=True),
+            hip_width_m=self.number(t, "hip_width_m", f, positive=True),
+            ankle_height_m=self.number(t, "ankle_height_m", f, non_negative=True, default=0.0),
+        )
+
+    def gait(self, t: dict) -> GaitSettings:
+        f = "gait"
+        return GaitSettings(
+            cycle_s=self.number(t, "cycle_s", f, positive=True),
+            max_step_m=self.number(t, "max_step_m", f, positive=True),
+            clearance_m=self.number(t, "clearance_m", f, positive=True),
+            rate_hz=self.number(t, "rate_hz", f, positive=True),
+        )
+
+    def bus(self, t: dict) -> BusSettings:
+        f = "bus"
+        backend = self.string(t, "backend", f, f"one of {', '.join(map(repr, BACKENDS))}")
+        if backend not in BACKENDS:
+            raise self.fail("bus.backend", f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
+        protocol: float | None = None
+        if backend == "dynamixel":
+            allowed = " or ".join(str(p) for p in DYNAMIXEL_PROTOCOLS)
+            protocol = self.number(t, "protocol", f)
+            if protocol not in DYNAMIXEL_PROTOCOLS:
+                raise self.fail("bus.protocol", f"unknown Dynamixel protocol {protocol} (allowed: {allowed})")
+        # Feetech servos speak one protocol; a protocol key there is accepted and ignored.
+        port = self.string(t, "port", f, "a serial port name, e.g. '/dev/ttyUSB0' or 'COM3'")
+        baudrate = self.integer(t, "baudrate", f, "a positive integer (bits per second)")
+        if baudrate <= 0:
+            raise self.fail("bus.baudrate", f"must be a positive integer (bits per second), got {baudrate}")
+        torque_off = t.get("torque_off_on_exit", False)
+        if not isinstance(torque_off, bool):
+            raise self.fail("bus.torque_off_on_exit", f"must be true or false, got {_kind(torque_off)}")
+        return BusSettings(backend=backend, protocol=protocol, port=port, baudrate=baudrate,
+                           torque_off_on_exit=torque_off)
+
+    def joints(self, data: dict, bus: BusSettings) -> tuple[JointConfig, ...]:
+        if "joints" not in data:
+            raise self.fail("joints", f"missing section (expected [joints.<name>] for {', '.join(WALKING_JOINTS)})")
+        tables = data["joints"]
+        if not isinstance(tables, dict):
+            raise self.fail("joints", f"must be tables [joints.<name>], got {_kind(tables)}")
+        for name in WALKING_JOINTS:
+            if name not in tables:
+                others = [n for n in tables if n not in WALKING_JOINTS]
+                close = difflib.get_close_matches(name, others, n=1)
+                hint = f"; is {close[0]!r} a typo of it?" if close else ""
+                raise self.fail(f"joints.{name}", f"missing walking joint (all of {', '.join(WALKING_JOINTS)} "
+                                                  f"are required{hint})")
+        order = list(WALKING_JOINTS) + [n for n in tables if n not in WALKING_JOINTS]
+        joints = tuple(self.joint(name, tables[name], bus) for name in order)
+        self.bus_wide_checks(joints, bus)
+        return joints
+
+    def joint(self, name: str, t: Any, bus: BusSettings) -> JointConfig:
+        f = f"joints.{name}"
+        if not isinstance(t, dict):
+            raise self.fail(f, f"must be a table [{f}], got {_kind(t)}")
+        self.no_unknown_keys(t, f, _JOINT_KEYS)
+        walking = name in WALKING_JOINTS
+
+        model_name = self.string(t, "model", f, f"a servo model ({', '.join(SERVO_MODELS)})")
+        if model_name not in SERVO_MODELS:
+            raise self.fail(f"{f}.model", f"unknown servo model {model_name!r} (allowed: {', '.join(SERVO_MODELS)})")
+        model = SERVO_MODELS[model_name]
+        if model.family != bus.backend:
+            fitting = [m.name for m in SERVO_MODELS.values() if m.family == bus.backend]
+            raise self.fail(f"{f}.model", f"{model_name} is a {model.family} servo but bus.backend is "
+                                          f"{bus.backend!r} (allowed: {', '.join(fitting)})")
+        if bus.protocol is not None and bus.protocol not in model.protocols:
+            spoken = ", ".join(str(p) for p in model.protocols)
+            raise self.fail("bus.protocol", f"{model_name} ({f}) does not speak protocol {bus.protocol} "
+                                            f"(it speaks {spoken})")
+
+        max_id = MAX_SERVO_ID[bus.backend]
+        servo_id = self.integer(t, "id", f, f"an integer servo id 0..{max_id}")
+        if not 0 <= servo_id <= max_id:
+            raise self.fail(f"{f}.id", f"{servo_id} is out of range for {bus.backend} (allowed: 0..{max_id})")
+
+        zero_tick = self.integer(t, "zero_tick", f, f"an integer tick {model.min_tick}..{model.max_tick}")
+        if not model.min_tick <= zero_tick <= model.max_tick:
+            raise self.fail(f"{f}.zero_tick", f"{zero_tick} is outside the {model_name}'s tick range "
+                                              f"{model.min_tick}..{model.max_tick}")
+        direction = self.integer(t, "direction", f, "1 or -1")
+        if direction not in (1, -1):
+            raise self.fail(f"{f}.direction", f"must be 1 or -1 (-1 for a mirror-mounted servo), got {direction}")
+
+        min_deg = self.number(t, "min_deg", f)
+        max_deg = self.number(t, "max_deg", f)
+        if min_deg > max_deg:
+            raise self.fail(f"{f}.min_deg", f"{min_deg} is above max_deg {max_deg}")
+        for key, angle_deg in (("min_deg", min_deg), ("max_deg", max_deg)):
+            tick = int(angle_rad_to_ticks(math.radians(angle_deg), zero_tick, direction, model.ticks_per_rad))
+            if not model.min_tick <= tick <= model.max_tick:
+                lo, hi = sorted(_tick_range_deg(model, zero_tick, direction))
+                raise self.fail(f"{f}.{key}", f"{angle_deg} deg maps to tick {tick}, outside the {model_name}'s "
+                                              f"range {model.min_tick}..{model.max_tick} (with zero_tick {zero_tick} "
+                                              f"and direction {direction} the allowed angles are "
+                                              f"{lo:.1f}..{hi:.1f} deg)")
+
+        max_velocity_dps = self.number(t, "max_velocity_dps", f, positive=True)
+        max_acceleration_dps2 = self.number(t, "max_acceleration_dps2", f, positive=True)
+
+        hold_deg: float | None = None
+        if walking:
+            if "hold_deg" in t:
+                raise self.fail(f"{f}.hold_deg", "only non-walking joints are held at a fixed angle; "
+                                                 "remove it from a walking joint")
+        else:
+            hold_deg = self.number(t, "hold_deg", f)
+            if not min_deg <= hold_deg <= max_deg:
+                raise self.fail(f"{f}.hold_deg", f"{hold_deg} is outside the joint's limits {min_deg}..{max_deg} deg")
+
+        return JointConfig(name=name, id=servo_id, model=model, zero_tick=zero_tick, direction=direction,
+                           min_deg=min_deg, max_deg=max_deg, max_velocity_dps=max_velocity_dps,
+                           max_acceleration_dps2=max_acceleration_dps2, hold_deg=hold_deg)
+
+    def bus_wide_checks(self, joints: tuple[JointConfig, ...], bus: BusSettings) -> None:
+        seen: dict[int, str] = {}
+        for j in joints:
+            if j.id in seen:
+                raise self.fail(f"joints.{j.name}.id", f"id {j.id} is already used by joints.{seen[j.id]} "
+                                                      f"(ids must be unique on one bus)")
+            seen[j.id] = j.name
+        first = joints[0]
+        for j in joints[1:]:
+            if j.model.byte_order != first.model.byte_order:
+                raise self.fail(f"joints.{j.name}.model",
+                                f"{j.model.name} sends {j.model.byte_order}-endian positions but "
+                                f"joints.{first.name} ({first.model.name}) is {first.model.byte_order}-endian; "
+                                f"one bus needs one byte order (e.g. Feetech STS or SCS, not both)")
+
+
+def _tick_range_deg(model: ServoModel, zero_tick: int, direction: int) -> tuple[float, float]:
+    """The angles (deg) at the two ends of the servo's tick range, for this zero_tick and direction."""
+    return tuple(math.degrees((tick - zero_tick) / (direction * model.ticks_per_rad))
+                 for tick in (model.min_tick, model.max_tick))  # type: ignore[return-value]
+
+
+def _kind(value: Any) -> str:
+    """A short description of a TOML value for error messages."""
+    if isinstance(value, bool):
+        return f"boolean {str(value).lower()}"
+    if isinstance(value, str):
+        return f"string {value!r}"
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, list):
+        return "an array"
+    if isinstance(value, (int, float)):
+        return f"number {value}"
+    return type(value).__name__
