@@ -70,33 +70,51 @@ _FEETECH_TABLE = dict(
 SERVO_MODELS: dict[str, ServoModel] = {
     m.name: m
     for m in (
-        # e-Manual XL430-W250 control table (Protocol 2.0 firmware; Protocol 1.0 selectable at addr 13).
-        # No-load speed 57 rpm at 11.1 V.
+        # Verified against emanual.robotis.com/docs/en/dxl/x/xl430-w250/ (ROBOTIS-GIT/emanual,
+        # docs/en/dxl/x/xl430-w250.md): model number 1060; Protocol Type (13) selects 1.0 or 2.0;
+        # Torque Enable 64 (1 B), Profile Velocity 112 (4 B), Goal Position 116 (4 B, 0..4095 in
+        # position mode), Present Position 132 (4 B, signed); 4096 pulse/rev.
+        # No-load speed 57 rev/min at 11.1 V (47 at 9 V, 61 at 12 V).
         ServoModel(name="XL430-W250", no_load_speed_rpm=57.0,
-                   source="ROBOTIS e-Manual, XL430-W250, control table", **_X_SERIES),
-        # e-Manual XM430-W350 control table; same X-series layout. No-load speed 46 rpm at 12 V.
+                   source="ROBOTIS e-Manual XL430-W250 control table and specifications (57 rpm @ 11.1 V)",
+                   **_X_SERIES),
+        # Verified against emanual.robotis.com/docs/en/dxl/x/xm430-w350/: model number 1020; same
+        # X-series addresses (64 / 112 / 116 / 132). No-load speed 46 rev/min at 12.0 V (43 @ 11.1 V).
         ServoModel(name="XM430-W350", no_load_speed_rpm=46.0,
-                   source="ROBOTIS e-Manual, XM430-W350, control table", **_X_SERIES),
-        # e-Manual XL-320: Protocol 2.0 only, 0-1023 over 300 deg, goal position 30 (2 B),
-        # moving speed 32, present position 37 (2 B). No-load speed 114 rpm at 7.4 V.
+                   source="ROBOTIS e-Manual XM430-W350 control table and specifications (46 rpm @ 12 V)",
+                   **_X_SERIES),
+        # Verified against emanual.robotis.com/docs/en/dxl/x/xl320/: Protocol 2.0 only, model 350,
+        # joint mode 0..1023 over 300 deg; Torque Enable 24 (1 B), Goal Position 30 (2 B),
+        # Moving Speed 32 (2 B), Present Position 37 (2 B). No-load speed 114 rev/min at 7.4 V.
         ServoModel(name="XL-320", family="dynamixel", protocols=(2.0,), addr_present_position=37,
                    len_present_position=2, no_load_speed_rpm=114.0,
-                   source="ROBOTIS e-Manual, XL-320, control table", **{**_AX_TABLE, "addr_torque_enable": 24}),
-        # e-Manual AX-12A: Protocol 1.0, 0-1023 over 300 deg, present position 36 (2 B).
-        # No-load speed 59 rpm at 12 V.
+                   source="ROBOTIS e-Manual XL-320 control table and specifications (114 rpm @ 7.4 V)",
+                   **_AX_TABLE),
+        # Verified against emanual.robotis.com/docs/en/dxl/ax/ax-12a/: Protocol 1.0, model 12,
+        # 0..1023 over 300 deg (0.29 deg/unit), Torque Enable 24, Goal Position 30 (2 B),
+        # Moving Speed 32 (2 B), Present Position 36 (2 B). No-load speed 59 rev/min at 12 V.
         ServoModel(name="AX-12A", family="dynamixel", protocols=(1.0,), addr_present_position=36,
                    len_present_position=2, no_load_speed_rpm=59.0,
-                   source="ROBOTIS e-Manual, AX-12/AX-12A, control table", **_AX_TABLE),
-        # Feetech STS3215 memory table (SMS/STS series, low byte first): 4096 ticks over 360 deg.
-        # 0.222 s/60 deg at 7.4 V, about 45 rpm.
+                   source="ROBOTIS e-Manual AX-12A control table and specifications (59 rpm @ 12 V)",
+                   **_AX_TABLE),
+        # Verified against the Feetech SMS/STS memory table as transcribed in LeRobot
+        # (lerobot/motors/feetech/tables.py, STS_SMS_SERIES_CONTROL_TABLE): model number 777 at
+        # address 3; Torque Enable 40 (1 B), Goal Position 42 (2 B), Goal Speed 46 (2 B),
+        # Present Position 56 (2 B); 4096 steps/rev; STS/SMS store words low byte first (SCS_END 0).
+        # No-load speed varies by variant: 0.222 s/60 deg = 45 rpm is the 12 V (C018) figure, the
+        # 7.4 V ST3215 is listed at 0.192 s/60 deg = 52 rpm. 45 rpm is kept: the lower figure is the
+        # conservative one for speed-limit checks.
         ServoModel(name="STS3215", resolution_ticks=4096, range_deg=360.0, min_tick=0, max_tick=4095,
                    centre_tick=2048, wraps=True, byte_order="little", no_load_speed_rpm=45.0,
-                   source="Feetech STS3215 datasheet and SMS/STS memory table", **_FEETECH_TABLE),
-        # Feetech SCS0009 memory table (SCS series, high byte first): 1024 ticks over 300 deg.
-        # 0.1 s/60 deg at 6 V, about 100 rpm.
+                   source="Feetech SMS/STS memory table (via LeRobot tables.py); STS3215 datasheet 45 rpm",
+                   **_FEETECH_TABLE),
+        # Verified against the Feetech SCSCL memory table (LeRobot SCS_SERIES_CONTROL_TABLE): model 1284,
+        # same addresses 40 / 42 / 46 / 56; SCS stores words high byte first (SCS_END 1).
+        # SC09/SCS0009 product page: 300 deg over 0..1023 (0.293 deg/step), 0.1 s/60 deg = 100 rpm at 6 V.
         ServoModel(name="SCS0009", resolution_ticks=1024, range_deg=300.0, min_tick=0, max_tick=1023,
                    centre_tick=512, wraps=False, byte_order="big", no_load_speed_rpm=100.0,
-                   source="Feetech SCS0009 datasheet and SCS memory table", **_FEETECH_TABLE),
+                   source="Feetech SCSCL memory table (via LeRobot tables.py); SC09 spec 100 rpm @ 6 V",
+                   **_FEETECH_TABLE),
     )
 }
 
