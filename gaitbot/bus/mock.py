@@ -1,0 +1,231 @@
+"""A serial port with a healthy servo chain behind it, for dry runs and tests.
+
+MockPort stands where the SDK's PortHandler stands (the httpx MockTransport idea): the real
+DynamixelBus / FeetechBus and the real SDK packet code run on top of it, so a dry run produces
+byte for byte what a real run would send. It parses each instruction packet with gaitbot.bus.wire
+(written from the protocol documents, not from the SDK) and answers as the servos would:
+
+* ping: status packet (Dynamixel 2.0 adds model number and firmware version);
+* write: stored in the servo's control table, status packet unless broadcast;
+* sync write: stored, no status packet;
+* read / sync read: status packets with the control-table bytes; present position mirrors the last
+  goal position written (initially the model's centre tick).
+
+Time is virtual: when no reply bytes are pending, ``isPacketTimeout`` is True at once, so a
+missing servo costs no wall-clock time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from gaitbot.bus import wire
+from gaitbot.robot.servo_models import ServoModel
+
+# Model numbers returned by ping / stored at the model-number address (e-Manual control tables;
+# Feetech via LeRobot's MODEL_NUMBER_TABLE).
+MODEL_NUMBERS = {"XL430-W250": 1060, "XM430-W350": 1020, "XL-320": 350, "AX-12A": 12, "STS3215": 777,
+                 "SCS0009": 1284}
+_FIRMWARE_VERSION = 45
+# Baud rates each SDK's PortHandler accepts, so a dry run refuses what a real run would refuse.
+SDK_BAUDRATES = {
+    "dynamixel": (9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 576000, 921600, 1000000,
+                  1152000, 2000000, 2500000, 3000000, 3500000, 4000000),
+    "feetech": (4800, 9600, 14400, 19200, 38400, 57600, 115200, 128000, 250000, 500000, 1000000),
+}
+_TABLE_SIZE_BYTES = 1024
+
+
+class MockPort:
+    """Duck-typed PortHandler for dynamixel_sdk and scservo_sdk with emulated servos behind it.
+
+    tx_packets / rx_packets keep every packet written by the host / answered by the chain, as bytes.
+    """
+
+    def __init__(self, backend: str, protocol: float, models: Mapping[int, ServoModel],
+                 port_name: str = "mock") -> None:
+        if backend not in SDK_BAUDRATES:
+            raise ValueError(f"unknown backend {backend!r} (known: {', '.join(SDK_BAUDRATES)})")
+        self.backend = backend
+        self.protocol = float(protocol)
+        self.framing = wire.framing_for(backend, protocol)
+        self.models = dict(models)
+        self.port_name = port_name
+        self.baudrate = 1_000_000
+        self.is_open = False
+        self.is_using = False  # the SDK uses this attribute as its bus lock
+        self.tx_packets: list[bytes] = []
+        self.rx_packets: list[bytes] = []
+        self.rejected: list[tuple[bytes, str]] = []  # instruction packets a servo would ignore
+        self._tx_buffer = bytearray()
+        self._rx_buffer = bytearray()
+        self._drop_replies = 0
+        self.tables = {servo_id: self._initial_table(model) for servo_id, model in self.models.items()}
+
+    # --- PortHandler interface -------------------------------------------------------------
+    def openPort(self) -> bool:  # noqa: N802 (SDK names)
+        self.is_open = True
+        return True
+
+    def closePort(self) -> None:  # noqa: N802
+        self.is_open = False
+
+    def setBaudRate(self, baudrate: int) -> bool:  # noqa: N802
+        if baudrate not in SDK_BAUDRATES[self.backend]:
+            return False
+        self.baudrate = baudrate
+        return True
+
+    def getBaudRate(self) -> int:  # noqa: N802
+        return self.baudrate
+
+    def getPortName(self) -> str:  # noqa: N802
+        return self.port_name
+
+    def setPortName(self, port_name: str) -> None:  # noqa: N802
+        self.port_name = port_name
+
+    def clearPort(self) -> None:  # noqa: N802
+        """Behave like the SDK being mocked: dynamixel_sdk drops input, scservo_sdk only flushes output."""
+        if self.backend == "dynamixel":
+            self._rx_buffer.clear()
+
+    def reset_input_buffer(self) -> None:
+        self._rx_buffer.clear()
+
+    def getBytesAvailable(self) -> int:  # noqa: N802
+        return len(self._rx_buffer)
+
+    def readPort(self, length: int) -> bytes:  # noqa: N802
+        chunk = bytes(self._rx_buffer[:length])
+        del self._rx_buffer[:length]
+        return chunk
+
+    def writePort(self, packet) -> int:  # noqa: N802
+        data = bytes(packet)
+        self._tx_buffer += data
+        packets, junk = wire.split_complete(self._tx_buffer, self.framing)
+        for raw in junk:
+            self.rejected.append((raw, "bytes outside any packet"))
+        for raw in packets:
+            self.tx_packets.append(raw)
+            self._answer(raw)
+        return len(data)
+
+    def setPacketTimeout(self, packet_length) -> None:  # noqa: N802
+        pass
+
+    def setPacketTimeoutMillis(self, msec) -> None:  # noqa: N802
+        pass
+
+    def isPacketTimeout(self) -> bool:  # noqa: N802
+        return not self._rx_buffer  # nothing pending now means nothing will ever come
+
+    # --- test helpers ----------------------------------------------------------------------
+    def drop_next_replies(self, count: int = 1) -> None:
+        """Lose the next ``count`` status packets, as a noisy bus would."""
+        self._drop_replies += count
+
+    def inject_input(self, data: bytes) -> None:
+        """Put stray bytes in the input buffer (a late reply from an earlier exchange)."""
+        self._rx_buffer += data
+
+    def present_ticks(self, servo_id: int) -> int:
+        model = self.models[servo_id]
+        start = model.addr_present_position
+        return int.from_bytes(self.tables[servo_id][start:start + model.len_present_position], model.byte_order)
+
+    # --- the emulated chain ----------------------------------------------------------------
+    def _initial_table(self, model: ServoModel) -> bytearray:
+        table = bytearray(_TABLE_SIZE_BYTES)
+        number_addr = 0 if self.backend == "dynamixel" else 3
+        table[number_addr:number_addr + 2] = MODEL_NUMBERS.get(model.name, 0).to_bytes(2, model.byte_order)
+        centre = model.centre_tick.to_bytes(model.len_goal_position, model.byte_order)
+        table[model.addr_goal_position:model.addr_goal_position + model.len_goal_position] = centre
+        table[model.addr_present_position:model.addr_present_position + model.len_present_position] = \
+            centre[:model.len_present_position]
+        return table
+
+    def _answer(self, raw: bytes) -> None:
+        frame = wire.parse(raw, self.framing, status=False)
+        if not frame.checksum_ok:
+            self.rejected.append((raw, frame.problem))  # a servo ignores a damaged packet
+            return
+        handler = {wire.INST_PING: self._ping, wire.INST_READ: self._read, wire.INST_WRITE: self._write,
+                   wire.INST_SYNC_WRITE: self._sync_write, wire.INST_SYNC_READ: self._sync_read}.get(frame.instruction)
+        if handler is None:
+            self.rejected.append((raw, f"instruction 0x{frame.instruction:02X} not emulated"))
+            return
+        handler(frame)
+
+    def _targets(self, packet_id: int) -> list[int]:
+        if packet_id == wire.BROADCAST_ID:
+            return list(self.tables)
+        return [packet_id] if packet_id in self.tables else []
+
+    def _address_and_rest(self, params: bytes) -> tuple[int, bytes]:
+        if self.framing == "v2":
+            return params[0] | params[1] << 8, params[2:]
+        return params[0], params[1:]
+
+    def _ping(self, frame: wire.Frame) -> None:
+        for servo_id in self._targets(frame.packet_id):
+            extra = b""
+            if self.framing == "v2":
+                number = MODEL_NUMBERS.get(self.models[servo_id].name, 0)
+                extra = bytes([number & 0xFF, number >> 8, _FIRMWARE_VERSION])
+            self._reply(servo_id, extra)
+
+    def _read(self, frame: wire.Frame) -> None:
+        address, rest = self._address_and_rest(frame.params)
+        length = rest[0] | (rest[1] << 8 if self.framing == "v2" else 0)
+        if frame.packet_id in self.tables:
+            self._reply(frame.packet_id, bytes(self.tables[frame.packet_id][address:address + length]))
+
+    def _write(self, frame: wire.Frame) -> None:
+        address, data = self._address_and_rest(frame.params)
+        for servo_id in self._targets(frame.packet_id):
+            self._store(servo_id, address, data)
+        if frame.packet_id in self.tables:
+            self._reply(frame.packet_id, b"")
+
+    def _sync_write(self, frame: wire.Frame) -> None:
+        address, rest = self._address_and_rest(frame.params)
+        if self.framing == "v2":
+            length, body = rest[0] | rest[1] << 8, rest[2:]
+        else:
+            length, body = rest[0], rest[1:]
+        for offset in range(0, len(body) - length, length + 1):
+            servo_id = body[offset]
+            if servo_id in self.tables:
+                self._store(servo_id, address, body[offset + 1:offset + 1 + length])
+
+    def _sync_read(self, frame: wire.Frame) -> None:
+        address, rest = self._address_and_rest(frame.params)
+        if self.framing == "v2":
+            length, ids = rest[0] | rest[1] << 8, rest[2:]
+        else:
+            length, ids = rest[0], rest[1:]
+        for servo_id in ids:
+            if servo_id in self.tables:
+                self._reply(servo_id, bytes(self.tables[servo_id][address:address + length]))
+
+    def _store(self, servo_id: int, address: int, data: bytes) -> None:
+        table, model = self.tables[servo_id], self.models[servo_id]
+        table[address:address + len(data)] = data
+        goal, length = model.addr_goal_position, model.len_goal_position
+        if address < goal + length and goal < address + len(data):
+            # an ideal servo: it is where it was told to be; copying raw bytes keeps the byte order
+            table[model.addr_present_position:model.addr_present_position + model.len_present_position] = \
+                table[goal:goal + model.len_present_position]
+
+    def _reply(self, servo_id: int, params: bytes) -> None:
+        if self.framing == "v2":
+            packet = wire.build_v2(servo_id, wire.INST_STATUS_V2, bytes([0]) + params)
+        else:
+            packet = wire.build_v1(servo_id, 0, params)
+        if self._drop_replies:
+            self._drop_replies -= 1
+            return
+        self.rx_packets.append(packet)
+        self._rx_buffer += packet
