@@ -1,0 +1,629 @@
+"""Tests of the real-time loop, the ramp planner and the walk session.
+
+No hardware and no wall-clock luck: time is a VirtualClock, and the bus is a fake that
+charges each call's cost to that clock and records what it was sent and when.
+Expected values come from hand computation or from properties (limits, end poses),
+never from figures printed by the code under test.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+
+import numpy as np
+import pytest
+
+from gaitbot.bus.base import Bus, BusError, ServoTimeout
+from gaitbot.clock import MonotonicClock, VirtualClock
+from gaitbot.ramp import ramp_ticks
+from gaitbot.stream import (
+    EXIT_CODES, MissingServosError, Streamer, latency_timer_warning, prepare, walk_session,
+)
+
+PERIOD_S = 1 / 60
+IDS = [1, 2, 3, 4]
+
+
+class FakeBus(Bus):
+    """Records every call with the virtual time it started at.
+
+    on_write(attempt, goals) runs at the start of each write_goal_ticks (attempt counts
+    calls from 0, including ones that raised) and may raise to simulate Ctrl-C, SIGTERM or a bus failure. After
+    ``die()``, every call raises ServoTimeout (a dead bus); after ``max_calls`` calls in
+    total a RuntimeError stops a runaway loop, so a hang shows up as a failure.
+    """
+
+    def __init__(self, clock: VirtualClock, present: dict[int, int] | None = None, missing=(),
+                 on_write=None, max_calls: int = 100_000) -> None:
+        self.clock = clock
+        self.present = dict(present or {i: 2048 for i in IDS})
+        self.missing = set(missing)
+        self.on_write = on_write
+        self.max_calls = max_calls
+        self.calls: list[tuple[str, float, object]] = []
+        self.writes: list[tuple[float, dict[int, int]]] = []
+        self.dead = False
+        self.closed = False
+        self.write_attempts = 0
+
+    def _call(self, name: str, arg: object = None) -> None:
+        self.calls.append((name, self.clock.now(), arg))
+        if len(self.calls) > self.max_calls:
+            raise RuntimeError("runaway: too many bus calls")
+        if self.dead and name != "close":
+            raise ServoTimeout(f"{name}: no answer (dead bus)")
+
+    def die(self) -> None:
+        self.dead = True
+
+    def open(self) -> None:
+        self._call("open")
+
+    def close(self) -> None:
+        self._call("close")
+        self.closed = True
+
+    def ping(self, servo_id: int) -> bool:
+        self._call("ping", servo_id)
+        return servo_id not in self.missing
+
+    def set_torque(self, ids, enabled: bool) -> None:
+        self._call("set_torque", (list(ids), enabled))
+
+    def write_goal_ticks(self, goals) -> None:
+        start_s = self.clock.now()
+        self._call("write", dict(goals))
+        attempt = self.write_attempts
+        self.write_attempts += 1
+        if self.on_write is not None:
+            self.on_write(attempt, goals)
+        self.writes.append((start_s, dict(goals)))
+        self.clock.charge_bus_call()
+
+    def read_present_ticks(self, ids) -> dict[int, int]:
+        self._call("read", list(ids))
+        return {i: self.present[i] for i in ids if i not in self.missing}
+
+    # helpers for assertions
+    def write_times(self) -> np.ndarray:
+        return np.array([t for t, _ in self.writes])
+
+    def write_ticks(self, ids=IDS) -> np.ndarray:
+        return np.array([[g[i] for i in ids] for _, g in self.writes], dtype=np.int64)
+
+    def names(self) -> list[str]:
+        return [name for name, _, _ in self.calls]
+
+
+def assert_within_limits(frames: np.ndarray, before: np.ndarray, max_velocity: float, max_accel: float,
+                         period_s: float = PERIOD_S, after: np.ndarray | None = None) -> None:
+    """Finite-difference velocity and acceleration of integer frames, starting from rest at ``before``."""
+    padded = [before, before, *frames] + ([after, after] if after is not None else [])
+    path = np.array(padded, dtype=np.float64)
+    velocity = np.diff(path, axis=0) / period_s
+    accel = np.diff(path, n=2, axis=0) / period_s**2
+    assert np.abs(velocity).max() <= max_velocity + 1e-9
+    assert np.abs(accel).max() <= max_accel + 1e-9
+
+
+def min_time_s(distance: float, max_velocity: float, max_accel: float) -> float:
+    """Rest-to-rest minimum time on one axis (bang-coast-bang), from the textbook formula."""
+    if distance * max_accel >= max_velocity**2:
+        return distance / max_velocity + max_velocity / max_accel
+    return 2 * math.sqrt(distance / max_accel)
+
+
+# --------------------------------------------------------------------------- clocks
+
+def test_virtual_clock_sleeps_forward_only_and_charges_bus_calls():
+    clock = VirtualClock(start_s=5.0, bus_call_cost_s=lambda i: 0.001 * (i + 1))
+    clock.sleep_until(7.0)
+    assert clock.now() == 7.0
+    clock.sleep_until(6.0)  # a passed deadline does not move time back
+    assert clock.now() == 7.0
+    assert clock.charge_bus_call() == pytest.approx(0.001)
+    assert clock.charge_bus_call() == pytest.approx(0.002)
+    assert clock.now() == pytest.approx(7.003)
+    with pytest.raises(ValueError):
+        clock.advance(-1.0)
+
+
+def test_monotonic_clock_never_returns_before_the_deadline():
+    clock = MonotonicClock()
+    for delay_s in (0.0, 0.0005, 0.003):  # below and above the spin threshold
+        deadline_s = clock.now() + delay_s
+        clock.sleep_until(deadline_s)
+        assert clock.now() >= deadline_s
+
+
+# --------------------------------------------------------------------------- streamer pacing
+
+def run_frames(costs_s, count: int, **kwargs):
+    clock = VirtualClock(start_s=100.0, bus_call_cost_s=costs_s)
+    bus = FakeBus(clock)
+    frames = np.arange(count)[:, None] + np.zeros((1, len(IDS)), dtype=np.int64)
+    stats = Streamer(bus, IDS, PERIOD_S, clock, **kwargs).run(frames)
+    return bus, stats
+
+
+def test_deadlines_are_absolute_no_drift_over_10000_frames_with_jittery_bus():
+    rng = np.random.default_rng(3)
+    costs_s = rng.uniform(0.0, 0.8 * PERIOD_S, size=10_000)
+    bus, stats = run_frames(lambda i: costs_s[i], 10_000)
+    expected_s = 100.0 + np.arange(10_000) * PERIOD_S
+    # Sleeping a period after each write would drift by the sum of the costs (about 67 s).
+    assert np.abs(bus.write_times() - expected_s).max() < 1e-9
+    assert stats.frames == 10_000 and stats.late_frames == 0
+
+
+def test_stalls_do_not_shift_later_deadlines():
+    # A 2.3-period stall every 997 calls; between stalls the schedule must come back to
+    # the original absolute deadlines (re-anchoring on the late send would not).
+    rng = np.random.default_rng(4)
+    costs_s = rng.uniform(0.0, 0.5 * PERIOD_S, size=10_000)
+    costs_s[::997] = 2.3 * PERIOD_S
+    bus, stats = run_frames(lambda i: costs_s[i], 10_000)
+    lateness_s = bus.write_times() - (100.0 + np.arange(10_000) * PERIOD_S)
+    assert lateness_s.min() > -1e-9                     # never early
+    assert abs(lateness_s[-1]) < 1e-9                   # on the original grid at the end
+    stall_frames = np.arange(0, 10_000, 997)
+    for k in stall_frames[:-1]:
+        # after a stall of 2.3 periods the next frame is 1.3 periods late and recovers
+        # a tenth of a period per frame: 13 late frames, then back on the grid
+        assert lateness_s[k + 1] == pytest.approx(1.3 * PERIOD_S, abs=1e-9)
+        assert np.abs(lateness_s[k + 14: k + 997]).max() < 1e-9
+    assert np.diff(bus.write_times()).min() >= 0.9 * PERIOD_S - 1e-9  # never a burst
+
+
+def test_late_frame_is_counted_and_not_followed_by_a_catch_up_burst():
+    # Frame 10's write takes 2.5 periods: frame 11 goes out 1.5 periods late; each later
+    # frame waits at least 0.9 period, so lateness falls by 0.1 period a frame:
+    # frames 11..25 are late by 1.5, 1.4, ..., 0.1 periods (15 frames), frame 26 is on time.
+    costs = {10: 2.5 * PERIOD_S}
+    bus, stats = run_frames(lambda i: costs.get(i, 0.1 * PERIOD_S), 40)
+    times_s = bus.write_times()
+    lateness_s = times_s - (100.0 + np.arange(40) * PERIOD_S)
+    expected_periods = np.zeros(40)
+    expected_periods[11:26] = 1.5 - 0.1 * np.arange(15)
+    np.testing.assert_allclose(lateness_s / PERIOD_S, expected_periods, atol=1e-9)
+    assert stats.late_frames == 15
+    assert np.diff(times_s).min() >= 0.9 * PERIOD_S - 1e-9
+    assert stats.frames == 40  # nothing skipped
+
+
+def test_stats_against_hand_computation():
+    # 100 frames; frame 20's write costs a period + 4 ms, every other write 1 ms.
+    # Frame 21 is due at 21P but the bus is busy until 21P + 4 ms: late 4 ms.
+    # Frame 22 waits until send21 + 0.9P = 22P + 4 ms - P/10: late 2.3333 ms.
+    # Frame 23: late 0.6667 ms (> 0.5 ms threshold). Frame 24 would be 1 ms early: on time.
+    p = PERIOD_S
+    costs = {20: p + 0.004}
+    bus, stats = run_frames(lambda i: costs.get(i, 0.001), 100)
+    late_ms = [4.0, 4.0 - p * 1e3 / 10, 4.0 - 2 * p * 1e3 / 10]
+    assert stats.frames == 100
+    assert stats.late_frames == 3
+    assert stats.max_lateness_s == pytest.approx(4e-3, abs=1e-12)
+    assert stats.lateness_median_s == pytest.approx(0.0, abs=1e-12)
+    # numpy linear percentile: position 0.99 * 99 = 98.01 between sorted[98] and sorted[99]
+    assert stats.lateness_p99_s * 1e3 == pytest.approx(late_ms[1] + 0.01 * (late_ms[0] - late_ms[1]), abs=1e-9)
+    assert stats.bus_call_median_s == pytest.approx(0.001, abs=1e-12)
+    assert stats.bus_call_max_s == pytest.approx(p + 0.004, abs=1e-12)
+    # sorted bus calls: 99 of 1 ms, then P + 4 ms; p99 position 98.01
+    assert stats.bus_call_p99_s == pytest.approx(0.001 + 0.01 * (p + 0.003), abs=1e-12)
+    # last frame (99) is on time, so the run lasts 99 periods plus its 1 ms write
+    assert stats.wall_s == pytest.approx(99 * p + 0.001, abs=1e-9)
+    assert stats.last_lateness_s == pytest.approx(0.0, abs=1e-12)
+    d = stats.to_dict()
+    assert d["frames"] == 100 and d["late_frames"] == 3
+    assert d["lateness_max_s"] == pytest.approx(4e-3, abs=1e-12)
+    assert 0.0 <= d["work_cpu_per_frame_s"] * 100 <= d["cpu_per_frame_s"] * 100 + 1e-9
+    text = stats.summary()
+    assert "100 frames" in text and "3 late" in text and "4.000 ms" in text
+
+
+def test_bus_call_median_with_an_even_count():
+    # costs 0..9 ms, ten of each, over 100 frames: the median is the mean of the 50th and
+    # 51st sorted values, 4 ms and 5 ms.
+    bus, stats = run_frames(lambda i: 0.001 * (i % 10), 100)
+    assert stats.bus_call_median_s == pytest.approx(0.0045, abs=1e-12)
+    assert stats.bus_call_p99_s == pytest.approx(0.009, abs=1e-12)
+    assert stats.late_frames == 0
+
+
+def test_cpu_time_is_taken_from_the_injected_counter():
+    ticks = iter(range(1000))
+    bus, stats = run_frames(0.001, 10, cpu_time_s=lambda: float(next(ticks)))
+    # one reading at start and end of the run, two per frame: 22 readings, 21 units in all;
+    # the frames account for 1 unit each.
+    assert stats.cpu_s == 21.0
+    assert stats.work_cpu_s == 10.0
+    assert stats.cpu_per_frame_s == pytest.approx(2.1)
+
+
+def test_on_frame_sees_every_frame_with_fresh_stats():
+    seen = []
+    clock = VirtualClock()
+    bus = FakeBus(clock)
+    streamer = Streamer(bus, IDS, PERIOD_S, clock, on_frame=lambda k, s: seen.append((k, s.frames)))
+    streamer.run(np.zeros((5, len(IDS)), dtype=np.int64))
+    assert seen == [(k, k + 1) for k in range(5)]
+
+
+def test_each_frame_is_one_write_with_python_int_ticks_by_id():
+    clock = VirtualClock()
+    bus = FakeBus(clock)
+    frames = np.array([[10, 20, 30, 40], [11, 21, 31, 41]], dtype=np.int32)
+    Streamer(bus, IDS, PERIOD_S, clock).run(frames)
+    assert [g for _, g in bus.writes] == [{1: 10, 2: 20, 3: 30, 4: 40}, {1: 11, 2: 21, 3: 31, 4: 41}]
+    assert all(type(v) is int for _, g in bus.writes for v in g.values())
+
+
+def test_streamer_rejects_bad_frames():
+    clock = VirtualClock()
+    streamer = Streamer(FakeBus(clock), IDS, PERIOD_S, clock)
+    with pytest.raises(ValueError, match="shape"):
+        streamer.run(np.zeros((3, 3), dtype=np.int64))
+    with pytest.raises(ValueError, match="whole ticks"):
+        streamer.run(np.full((3, 4), 0.5))
+    empty = streamer.run(np.zeros((0, 4), dtype=np.int64))
+    assert empty.frames == 0 and empty.lateness_p99_s == 0.0
+
+
+# --------------------------------------------------------------------------- ramps
+
+@pytest.mark.parametrize("seed", range(8))
+def test_ramp_respects_limits_reaches_target_and_is_synchronised(seed):
+    rng = np.random.default_rng(seed)
+    joints = 12
+    start = rng.integers(500, 3500, size=joints)
+    target = rng.integers(500, 3500, size=joints)
+    max_velocity = float(rng.uniform(300, 4000))      # ticks/s
+    max_accel = float(rng.uniform(10_000, 80_000))    # ticks/s^2
+    frames = ramp_ticks(start, target, max_velocity, max_accel, PERIOD_S)
+    assert frames.dtype.kind == "i"
+    np.testing.assert_array_equal(frames[-1], target)
+    assert_within_limits(frames, start, max_velocity, max_accel, after=target)
+    # synchronised: every joint has covered the same fraction of its way, up to rounding
+    delta = (target - start).astype(float)
+    lead = int(np.argmax(np.abs(delta)))
+    fraction = (frames[:, lead] - start[lead]) / delta[lead]
+    moving = np.abs(delta) > 0
+    expected = start[moving] + fraction[:, None] * delta[moving]
+    assert np.abs(frames[:, moving] - expected).max() <= 0.5 + 0.5 * np.abs(delta[moving]).max() / np.abs(delta[lead])
+    # duration: not faster than physics allows, not much slower than the rounding margins require
+    distance = np.abs(delta).max()
+    duration_s = len(frames) * PERIOD_S
+    assert duration_s >= min_time_s(distance, max_velocity, max_accel) - 1e-9
+    assert duration_s <= min_time_s(distance, max_velocity - 1 / PERIOD_S, max_accel - 2 / PERIOD_S**2) + PERIOD_S
+
+
+def test_ramp_short_move_is_a_triangle_within_limits():
+    start, target = np.array([2000, 2000]), np.array([2030, 1990])
+    frames = ramp_ticks(start, target, 5000.0, 40_000.0, PERIOD_S)
+    np.testing.assert_array_equal(frames[-1], target)
+    assert_within_limits(frames, start, 5000.0, 40_000.0, after=target)
+
+
+def test_ramp_is_empty_when_already_within_one_tick():
+    frames = ramp_ticks([100, 200, 300], [101, 200, 299], 1000.0, 20_000.0, PERIOD_S)
+    assert frames.shape == (0, 3)
+    assert ramp_ticks([100, 200], [102, 200], 1000.0, 20_000.0, PERIOD_S).shape[0] >= 1
+
+
+def test_ramp_with_limits_below_tick_resolution_stays_within_one_tick_of_quantisation():
+    # 30 ticks/s is half a tick per frame at 60 Hz: integer frames cannot be smoother than
+    # one tick steps, so the promise is the limit plus one tick of quantisation.
+    start, target = np.array([0, 0]), np.array([50, -20])
+    max_velocity, max_accel = 30.0, 1000.0
+    frames = ramp_ticks(start, target, max_velocity, max_accel, PERIOD_S)
+    np.testing.assert_array_equal(frames[-1], target)
+    assert_within_limits(frames, start, max_velocity + 1 / PERIOD_S, max_accel + 2 / PERIOD_S**2, after=target)
+
+
+def test_ramp_rejects_bad_input():
+    with pytest.raises(ValueError):
+        ramp_ticks([0, 0], [10], 100.0, 100.0, PERIOD_S)
+    with pytest.raises(ValueError):
+        ramp_ticks([0], [10], 0.0, 100.0, PERIOD_S)
+
+
+# --------------------------------------------------------------------------- prepare and the session
+
+VMAX = 2000.0    # ticks/s
+AMAX = 30_000.0  # ticks/s^2
+STAND = np.array([2048, 2048, 2048, 2048])
+
+
+def gait_frames(count: int = 120) -> np.ndarray:
+    """A smooth gait-like trajectory that starts and ends at STAND, well within the limits."""
+    t = np.arange(count) * PERIOD_S
+    phase = 2 * np.pi * t / (count * PERIOD_S)
+    amplitude = np.array([120, -80, 60, -100])
+    return np.rint(STAND + amplitude * (1 - np.cos(phase))[:, None] / 2).astype(np.int64)
+
+
+def session(bus, clock, frames=None, **kwargs):
+    kwargs.setdefault("torque_off_on_exit", True)
+    return walk_session(bus, IDS, gait_frames() if frames is None else frames, STAND,
+                        max_velocity_ticks_per_s=VMAX, max_accel_ticks_per_s2=AMAX,
+                        period_s=PERIOD_S, clock=clock, **kwargs)
+
+
+def start_pose_bus(clock, **kwargs) -> FakeBus:
+    present = {1: 1800, 2: 2300, 3: 2048, 4: 1900}
+    return FakeBus(clock, present=present, **kwargs)
+
+
+def test_prepare_names_every_missing_id():
+    clock = VirtualClock()
+    bus = FakeBus(clock, present={i: 0 for i in range(1, 7)}, missing={2, 5})
+    with pytest.raises(MissingServosError) as info:
+        prepare(bus, [1, 2, 3, 4, 5, 6])
+    assert info.value.missing_ids == [2, 5]
+    assert "servos 2, 5 did not answer" in str(info.value)
+
+
+def test_prepare_returns_present_ticks_in_id_order():
+    clock = VirtualClock()
+    bus = FakeBus(clock, present={1: 11, 2: 22, 3: 33, 4: 44})
+    np.testing.assert_array_equal(prepare(bus, [3, 1, 4, 2]), [33, 11, 44, 22])
+
+
+def test_session_with_missing_servos_moves_nothing_and_closes():
+    clock = VirtualClock()
+    bus = FakeBus(clock, missing={3})
+    result = session(bus, clock)
+    assert result.outcome == "bus_error" and result.exit_code == 1
+    assert isinstance(result.error, MissingServosError) and result.error.missing_ids == [3]
+    assert "write" not in bus.names() and "set_torque" not in bus.names()
+    assert bus.closed
+
+
+def test_session_completed_ramps_in_walks_and_ends_standing():
+    clock = VirtualClock(bus_call_cost_s=0.002)
+    bus = start_pose_bus(clock)
+    walk = gait_frames()
+    result = session(bus, clock, frames=walk)
+    assert result.outcome == "completed" and result.exit_code == 0 and result.error is None
+    names = bus.names()
+    # goal = present before torque on, so enabling torque moves nothing
+    present = np.array([1800, 2300, 2048, 1900])
+    first_write = names.index("write")
+    assert names.index("set_torque") > first_write
+    written = bus.write_ticks()
+    np.testing.assert_array_equal(written[0], present)
+    # the start ramp, then the walk verbatim, then nothing else (the walk ends standing)
+    ramp_len = len(written) - 1 - len(walk)
+    assert ramp_len > 0
+    assert_within_limits(written[1: 1 + ramp_len], present, VMAX, AMAX, after=walk[0])
+    np.testing.assert_array_equal(written[1 + ramp_len:], walk)
+    assert result.reached_stand and result.walk_stats.frames == len(walk)
+    assert names[-2:] == ["set_torque", "close"] and bus.calls[-2][2] == (IDS, False)
+    assert result.torque_off
+
+
+def test_session_keeps_torque_on_when_asked():
+    clock = VirtualClock()
+    bus = start_pose_bus(clock)
+    result = session(bus, clock, torque_off_on_exit=False)
+    assert result.outcome == "completed" and not result.torque_off
+    assert [c[2] for c in bus.calls if c[0] == "set_torque"] == [(IDS, True)]
+
+
+def test_session_ramps_to_stand_when_trajectory_ends_elsewhere():
+    clock = VirtualClock()
+    bus = start_pose_bus(clock)
+    walk = gait_frames()[:60]  # stops half way, away from STAND
+    result = session(bus, clock, frames=walk)
+    written = bus.write_ticks()
+    np.testing.assert_array_equal(written[-1], STAND)
+    tail = written[len(written) - 1 - np.flatnonzero((written[::-1] == walk[-1]).all(axis=1))[0] + 1:]
+    assert_within_limits(tail, walk[-1], VMAX, AMAX, after=STAND)
+    assert result.reached_stand
+
+
+def raise_at_walk_frames(raisers: dict):
+    """on_write hook raising ``raisers[j]()`` at the write attempt walk-start + j.
+
+    The walk starts with the attempt after the first write equal to walk[0] (the start
+    ramp ends on walk[0] and the walk begins with it again). Offsets past the last walk
+    frame that was attempted fall on the stop ramp.
+    """
+    walk = gait_frames()
+    state = {"walk_start": None}
+
+    def hook(attempt, goals):
+        if state["walk_start"] is None and [goals[i] for i in IDS] == walk[0].tolist():
+            state["walk_start"] = attempt + 1
+        start = state["walk_start"]
+        if start is not None and attempt - start in raisers:
+            raisers[attempt - start]()
+    hook.state = state
+    return hook, walk
+
+
+def interrupt_at_walk_frame(k: int, exc_factory):
+    return raise_at_walk_frames({k: exc_factory})
+
+
+def check_stop_ramp(bus: FakeBus, interrupted_ticks: np.ndarray, stop_writes: np.ndarray) -> None:
+    """Writes after the interruption: within limits from the interrupted pose, ending at STAND,
+    each joint between where it was and STAND (no further walk frames)."""
+    np.testing.assert_array_equal(stop_writes[-1], STAND)
+    assert_within_limits(stop_writes, interrupted_ticks, VMAX, AMAX, after=STAND)
+    low = np.minimum(interrupted_ticks, STAND)
+    high = np.maximum(interrupted_ticks, STAND)
+    assert ((stop_writes >= low) & (stop_writes <= high)).all()
+
+
+def test_ctrl_c_ramps_to_stand_and_exits_130():
+    k = 40
+
+    def ctrl_c():
+        raise KeyboardInterrupt
+
+    hook, walk = interrupt_at_walk_frame(k, ctrl_c)
+    clock = VirtualClock(bus_call_cost_s=0.001)
+    bus = start_pose_bus(clock, on_write=hook)
+    result = session(bus, clock)
+    assert result.outcome == "interrupted" and result.exit_code == 130
+    assert result.walk_stats.frames == k
+    # the interrupted write did not reach the fake bus; the stop starts from that frame
+    stop_writes = split_at_interrupt(bus, walk, k)
+    check_stop_ramp(bus, walk[k], stop_writes)
+    assert result.reached_stand and result.torque_off
+    assert bus.names()[-2:] == ["set_torque", "close"]
+
+
+def split_at_interrupt(bus: FakeBus, walk: np.ndarray, k: int) -> np.ndarray:
+    """Writes after walk frame k-1 (frame k raised before being recorded)."""
+    written = bus.write_ticks()
+    for i in range(k, len(written)):
+        if (written[i - k: i] == walk[:k]).all():
+            return written[i:]
+    raise AssertionError("walk frames not found in the writes")
+
+
+def test_sigterm_ramps_to_stand_exits_143_and_restores_the_old_handler():
+    k = 25
+    called = []
+
+    def sentinel(signum, frame):
+        called.append(signum)
+
+    def sigterm():
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    hook, walk = interrupt_at_walk_frame(k, sigterm)
+    clock = VirtualClock(bus_call_cost_s=0.001)
+    bus = start_pose_bus(clock, on_write=hook)
+    previous = signal.signal(signal.SIGTERM, sentinel)
+    try:
+        result = session(bus, clock)
+        assert signal.getsignal(signal.SIGTERM) is sentinel
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert called == []  # our handler took it, not the sentinel
+    assert result.outcome == "terminated" and result.exit_code == 143
+    check_stop_ramp(bus, walk[k], split_at_interrupt(bus, walk, k))
+    assert result.torque_off and bus.closed
+
+
+def test_second_ctrl_c_abandons_the_stop_ramp_and_turns_torque_off():
+    k = 30
+
+    def ctrl_c():
+        raise KeyboardInterrupt
+
+    # first Ctrl-C at walk frame k; the second at the third stop-ramp frame (attempt k + 3)
+    hook, walk = raise_at_walk_frames({k: ctrl_c, k + 3: ctrl_c})
+    clock = VirtualClock()
+    bus = start_pose_bus(clock, on_write=hook)
+    result = session(bus, clock, frames=walk)
+    assert result.outcome == "interrupted" and result.exit_code == 130
+    walk_start = hook.state["walk_start"]
+    # every attempt before the first Ctrl-C went out, then two stop-ramp frames, then nothing
+    assert len(bus.writes) == walk_start + k + 2
+    assert bus.write_attempts == walk_start + k + 4
+    assert not result.reached_stand
+    assert result.torque_off and bus.names()[-2:] == ["set_torque", "close"]
+    assert any("abandoned" in note for note in result.notes)
+
+
+def test_dead_bus_gives_exit_1_without_hanging():
+    k = 10
+    hook_state = {}
+
+    def fail():
+        hook_state["bus"].die()
+        raise ServoTimeout("servo 3 did not answer", servo_id=3)
+
+    hook, walk = interrupt_at_walk_frame(k, fail)
+    clock = VirtualClock()
+    bus = start_pose_bus(clock, on_write=hook, max_calls=10_000)
+    hook_state["bus"] = bus
+    result = session(bus, clock)
+    assert result.outcome == "bus_error" and result.exit_code == 1
+    assert isinstance(result.error, ServoTimeout) and result.error.servo_id == 3
+    # after the failure: one write attempt (the stop ramp gives up at once), one torque-off attempt, close
+    failure = max(i for i, c in enumerate(bus.calls) if c[0] == "write" and c[2] == dict(zip(IDS, walk[k].tolist())))
+    assert bus.names()[failure + 1:] == ["write", "set_torque", "close"]
+    assert not result.torque_off and not result.reached_stand
+    assert "servo 3" in result.message()
+
+
+def test_transient_bus_error_still_ramps_to_stand():
+    k = 50
+
+    def fail():
+        raise BusError("checksum error")
+
+    hook, walk = interrupt_at_walk_frame(k, fail)
+    clock = VirtualClock()
+    bus = start_pose_bus(clock, on_write=hook)
+    result = session(bus, clock)
+    assert result.outcome == "bus_error" and result.exit_code == 1
+    check_stop_ramp(bus, walk[k], split_at_interrupt(bus, walk, k))
+    assert result.reached_stand and result.torque_off and bus.closed
+
+
+def test_unexpected_error_still_stops_safely_closes_and_reraises():
+    k = 5
+
+    def bug():
+        raise ZeroDivisionError("bug in a lower layer")
+
+    hook, walk = interrupt_at_walk_frame(k, bug)
+    clock = VirtualClock()
+    bus = start_pose_bus(clock, on_write=hook)
+    with pytest.raises(ZeroDivisionError):
+        session(bus, clock)
+    np.testing.assert_array_equal(bus.write_ticks()[-1], STAND)
+    assert bus.names()[-2:] == ["set_torque", "close"]
+
+
+def test_exit_codes_are_the_shell_conventions():
+    assert EXIT_CODES == {"completed": 0, "interrupted": 128 + signal.SIGINT,
+                          "terminated": 128 + signal.SIGTERM, "bus_error": 1}
+
+
+# --------------------------------------------------------------------------- latency timer
+
+def fake_sysfs(tmp_path, device: str, content: str):
+    directory = tmp_path / "sys" / "bus" / "usb-serial" / "devices" / device
+    directory.mkdir(parents=True)
+    (directory / "latency_timer").write_text(content)
+    return str(tmp_path / "sys")
+
+
+def test_latency_timer_warning_at_the_default_16_ms(tmp_path):
+    root = fake_sysfs(tmp_path, "ttyUSB0", "16\n")
+    warning = latency_timer_warning("/dev/ttyUSB0", sysfs_root=root)
+    assert warning is not None and "\n" not in warning
+    assert "16 ms" in warning
+    assert "echo 1 | sudo tee" in warning and "ttyUSB0/latency_timer" in warning
+    assert "udev" in warning
+
+
+def test_latency_timer_of_1_ms_is_fine(tmp_path):
+    root = fake_sysfs(tmp_path, "ttyUSB0", "1\n")
+    assert latency_timer_warning("/dev/ttyUSB0", sysfs_root=root) is None
+
+
+def test_latency_timer_unknown_device_or_unreadable_gives_no_warning(tmp_path):
+    root = fake_sysfs(tmp_path, "ttyUSB1", "garbage")
+    assert latency_timer_warning("/dev/ttyUSB1", sysfs_root=root) is None
+    assert latency_timer_warning("/dev/ttyACM0", sysfs_root=root) is None
+    assert latency_timer_warning("COM3", sysfs_root=root) is None
+
+
+def test_latency_timer_follows_by_id_symlinks(tmp_path):
+    root = fake_sysfs(tmp_path, "ttyUSB2", "16")
+    (tmp_path / "dev").mkdir()
+    (tmp_path / "dev" / "ttyUSB2").write_text("")
+    link = tmp_path / "dev" / "usb-FTDI_FT232R_A1B2C3-if00-port0"
+    link.symlink_to(tmp_path / "dev" / "ttyUSB2")
+    warning = latency_timer_warning(str(link), sysfs_root=root)
+    assert warning is not None and "ttyUSB2" in warning
