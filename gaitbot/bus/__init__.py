@@ -1,1 +1,9 @@
-"""The bus room: one abstract servo bus, one module per backend, and a recording mock port."""
+"""The bus room: one abstract servo bus, one module per backend, and a recording mock port.
+
+    make_bus(backend, protocol, port, baudrate, models, dry_run, recorder=None) -> Bus
+"""
+
+from gaitbot.bus.base import Bus, BusError, PortError, ServoStatusError, ServoTimeout
+from gaitbot.bus.factory import make_bus, make_mock_bus
+
+__all__ = ["Bus", "BusError", "PortError", "ServoStatusError", "ServoTimeout", "make_bus", "make_mock_bus"]

@@ -104,10 +104,10 @@ class MockPort:
     def writePort(self, packet) -> int:  # noqa: N802
         data = bytes(packet)
         self._tx_buffer += data
-        packets, junk = wire.split_complete(self._tx_buffer, self.framing)
-        for raw in junk:
-            self.rejected.append((raw, "bytes outside any packet"))
-        for raw in packets:
+        for raw, is_packet in wire.split_complete(self._tx_buffer, self.framing):
+            if not is_packet:
+                self.rejected.append((raw, "bytes outside any packet"))
+                continue
             self.tx_packets.append(raw)
             self._answer(raw)
         return len(data)

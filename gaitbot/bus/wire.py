@@ -149,31 +149,31 @@ def _parse_v2(raw: bytes, status: bool) -> Frame:
     return Frame(raw[4], payload[0], None, payload[1:], ok, problem)
 
 
-def split_complete(buffer: bytearray, framing: str) -> tuple[list[bytes], list[bytes]]:
-    """Remove whole packets from the front of ``buffer``.
+def split_complete(buffer: bytearray, framing: str) -> list[tuple[bytes, bool]]:
+    """Remove whole packets from the front of ``buffer``, in arrival order.
 
-    Returns (packets, junk): junk are byte runs before a header (line noise, echoes); a trailing
-    incomplete packet stays in ``buffer`` for more bytes to arrive.
+    Returns (bytes, is_packet) pairs: is_packet False marks a byte run before a header (line noise,
+    a truncated reply). A trailing incomplete packet, or the start of a header, stays in ``buffer``
+    for more bytes to arrive.
     """
-    packets: list[bytes] = []
-    junk: list[bytes] = []
+    chunks: list[tuple[bytes, bool]] = []
     while buffer:
         start = find_header(bytes(buffer), framing)
         if start < 0:
             keep = _partial_header_suffix(bytes(buffer), framing)
             if len(buffer) > keep:
-                junk.append(bytes(buffer[: len(buffer) - keep]))
+                chunks.append((bytes(buffer[: len(buffer) - keep]), False))
                 del buffer[: len(buffer) - keep]
             break
         if start > 0:
-            junk.append(bytes(buffer[:start]))
+            chunks.append((bytes(buffer[:start]), False))
             del buffer[:start]
         total = packet_length(bytes(buffer), framing)
         if total is None or len(buffer) < total:
             break
-        packets.append(bytes(buffer[:total]))
+        chunks.append((bytes(buffer[:total]), True))
         del buffer[:total]
-    return packets, junk
+    return chunks
 
 
 def _partial_header_suffix(buffer: bytes, framing: str) -> int:
