@@ -203,7 +203,6 @@ class Streamer:
                             lateness_s=np.zeros(count), bus_call_s=np.zeros(count))
         self.stats = stats
         clock, bus, ids, cpu = self.clock, self.bus, self.ids, self.cpu_time_s
-        rows = frames.tolist()  # Python ints: SDK packet builders want ints, not numpy scalars
         cpu_start = cpu()
         start_s = clock.now()
         earliest_s = start_s
@@ -214,7 +213,9 @@ class Streamer:
                 send_s = clock.now()
                 work_cpu_start = cpu()
                 self.last_sent_ticks = frames[k]
-                bus.write_goal_ticks(dict(zip(ids, rows[k])))
+                # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
+                # time: converting a whole one-hour walk up front would take ~100 MB.
+                bus.write_goal_ticks(dict(zip(ids, frames[k].tolist())))
                 done_s = clock.now()
                 stats._record(send_s - deadline_s, done_s - send_s)
                 stats.wall_s = done_s - start_s
@@ -376,19 +377,21 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             outcome, error = "completed", None
         except (KeyboardInterrupt, Terminated) as exc:
             outcome, error = ("terminated" if isinstance(exc, Terminated) else "interrupted"), None
-            state.safe_stop(streamer, ramp, stand, abandon_on_bus_error=False)
+            state.safe_stop(streamer, ramp, stand)
         except BusError as exc:
             outcome, error = "bus_error", exc
-            state.safe_stop(streamer, ramp, stand, abandon_on_bus_error=True)
+            state.safe_stop(streamer, ramp, stand)
         except Exception:
-            state.safe_stop(streamer, ramp, stand, abandon_on_bus_error=True)
+            state.safe_stop(streamer, ramp, stand)
             state.finish(bus, ids, torque_off_on_exit)
             raise
         state.finish(bus, ids, torque_off_on_exit)
     finally:
-        state.close(bus)
-        if handle_sigterm:
-            _restore_sigterm_handler(old_handler)
+        try:
+            state.close(bus)
+        finally:
+            if handle_sigterm:
+                _restore_sigterm_handler(old_handler)
     return SessionResult(
         outcome=outcome, exit_code=EXIT_CODES[outcome], error=error, walk_stats=state.walk_stats,
         reached_stand=state.last_sent is not None and int(np.max(np.abs(state.last_sent - stand))) <= 1,
@@ -418,7 +421,7 @@ class _SessionState:
             self.walk_stats = stats
 
     def safe_stop(self, streamer: Callable[[], Streamer], ramp: Callable[[np.ndarray, np.ndarray], np.ndarray],
-                  stand: np.ndarray, abandon_on_bus_error: bool) -> None:
+                  stand: np.ndarray) -> None:
         """Ramp from the last sent pose to stand, once; give up on a bus error or a second signal."""
         if not self.torque_on or self.last_sent is None:
             return  # nothing moved: the robot is where it was
@@ -443,11 +446,18 @@ class _SessionState:
             self.notes.append(f"torque off failed: {exc}")
 
     def close(self, bus: Bus) -> None:
+        """Close once, whatever happens: a failure or a further interrupt becomes a note.
+
+        Closing flushes a recording made by the bus room, so it must not be skipped, and an
+        error here must not hide how the walk ended.
+        """
         if not self.opened:
             return
         try:
             bus.close()
-        except BusError as exc:
+        except (KeyboardInterrupt, Terminated):
+            self.notes.append("closing the bus was interrupted")
+        except Exception as exc:  # noqa: BLE001 - reported to the caller in the notes
             self.notes.append(f"closing the bus failed: {exc}")
 
 

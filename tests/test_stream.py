@@ -627,3 +627,27 @@ def test_latency_timer_follows_by_id_symlinks(tmp_path):
     link.symlink_to(tmp_path / "dev" / "ttyUSB2")
     warning = latency_timer_warning(str(link), sysfs_root=root)
     assert warning is not None and "ttyUSB2" in warning
+
+
+@pytest.mark.parametrize("close_exc", [KeyboardInterrupt, OSError])
+def test_a_failing_close_is_reported_and_the_sigterm_handler_still_restored(close_exc):
+    clock = VirtualClock()
+
+    class ClosingFails(FakeBus):
+        def close(self):
+            super().close()
+            raise close_exc("flush failed")
+
+    bus = ClosingFails(clock, present={i: 2048 for i in IDS})
+
+    def sentinel(signum, frame):
+        pass
+
+    previous = signal.signal(signal.SIGTERM, sentinel)
+    try:
+        result = session(bus, clock)
+        assert signal.getsignal(signal.SIGTERM) is sentinel
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert result.outcome == "completed" and bus.closed
+    assert any("closing the bus" in note for note in result.notes)
