@@ -157,13 +157,15 @@ class CheckReport:
                  f"margin {self.margin_deg:g} deg: {'OK' if self.ok else 'FAIL'}"
                  f" ({len(self.errors)} errors, {len(self.warnings)} warnings)",
                  "",
-                 f"{'joint':<20} {'used deg':>17} {'limits deg':>15} {'closest':>8} "
-                 f"{'|vel| / limit dps':>19} {'|acc| / limit dps^2':>21}  verdict"]
+                 f"{'joint':<20} {'used deg':>16} {'limits deg':>14} {'closest deg':>11} "
+                 f"{'|vel| / limit deg/s':>21} {'|acc| / limit deg/s^2':>23}  verdict"]
         for j in self.joints:
-            lines.append(
-                f"{j.joint:<20} {j.used_min_deg:>8.1f}..{j.used_max_deg:<7.1f} {j.min_deg:>6.1f}..{j.max_deg:<7.1f} "
-                f"{j.closest_to_limit_deg:>8.1f} {j.worst_velocity_dps:>8.1f} / {j.max_velocity_dps:<8.1f} "
-                f"{j.worst_acceleration_dps2:>9.0f} / {j.max_acceleration_dps2:<9.0f}  {j.verdict}")
+            used = f"{j.used_min_deg:.1f}..{j.used_max_deg:.1f}"
+            limits = f"{j.min_deg:.1f}..{j.max_deg:.1f}"
+            vel = f"{j.worst_velocity_dps:.1f} / {j.max_velocity_dps:.0f}"
+            acc = f"{j.worst_acceleration_dps2:.0f} / {j.max_acceleration_dps2:.0f}"
+            lines.append(f"{j.joint:<20} {used:>16} {limits:>14} {j.closest_to_limit_deg:>11.1f} "
+                         f"{vel:>21} {acc:>23}  {j.verdict}")
         lines += ["", f"velocity: {self.velocity_method}", f"acceleration: {self.acceleration_method}"]
         for kind in KIND_ORDER:
             found = [v for v in self.violations if v.kind == kind]

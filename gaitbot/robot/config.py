@@ -167,9 +167,11 @@ def shipped_config_dirs() -> list[Path]:
             dirs.append(packaged)
     except (ModuleNotFoundError, OSError):  # pragma: no cover - gaitbot is importable if we run
         pass
-    source = Path(__file__).resolve().parents[2] / "config"
-    if source.is_dir():
-        dirs.append(source)
+    checkout = Path(__file__).resolve().parents[2]
+    # Only a source checkout (pyproject.toml beside gaitbot/): in an installed wheel parents[2] is
+    # site-packages, where a "config" directory would belong to some other distribution.
+    if (checkout / "pyproject.toml").is_file() and (checkout / "config").is_dir():
+        dirs.append(checkout / "config")
     return dirs
 
 
