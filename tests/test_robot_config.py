@@ -105,7 +105,8 @@ def test_shipped_servo_choices():
     assert xl.bus.backend == "dynamixel" and xl.bus.protocol == 2.0
     sts = load_robot_config(resolve_config("sts3215-biped"))
     assert {j.model.name for j in sts.joints} == {"STS3215"} and sts.bus.backend == "feetech"
-    assert sts.bus.protocol is None
+    assert sts.bus.protocol == 1.0  # Feetech speaks one, Dynamixel-1.0-shaped protocol
+    assert xl.models_by_id == {i: xl.joints[0].model for i in range(1, 7)}
     ax = load_robot_config(resolve_config("ax12a-biped"))
     assert {j.model.name for j in ax.joints} == {"AX-12A"} and ax.bus.protocol == 1.0
 
@@ -313,8 +314,8 @@ def test_dynamixel_needs_protocol(tmp_path):
 
 
 def test_feetech_protocol_is_ignored(tmp_path):
-    text = shipped_text("sts3215-biped").replace('backend = "feetech"', 'backend = "feetech"\nprotocol = 1.0')
-    assert load_text(tmp_path, text).bus.protocol is None
+    text = shipped_text("sts3215-biped").replace('backend = "feetech"', 'backend = "feetech"\nprotocol = 2.0')
+    assert load_text(tmp_path, text).bus.protocol == 1.0
 
 
 def test_mixed_feetech_byte_orders(tmp_path):
@@ -420,3 +421,25 @@ def test_config_module_does_not_import_the_bus_room():
 
     source = Path(module.__file__).read_text()
     assert "gaitbot.bus" not in re.sub(r'(?s)""".*?"""', "", source)
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_shipped_configs_fit_the_bus_frame_budget_through_the_hook(tmp_path, name):
+    """The wiring the CLI is expected to use: the bus room's rate check, adapted to a ConfigError,
+    passed as an extra check. Every shipped robot must carry 60 Hz with read-back at 1 Mbaud,
+    and none can at 9600 baud (8 servos x ~14 bytes x 10 bits > 0.7 x 16.7 ms)."""
+    budget = pytest.importorskip("gaitbot.bus.budget")
+
+    def bus_can_carry_rate(config: RobotConfig) -> None:
+        try:
+            budget.check_rate(config.gait.rate_hz, config.bus.backend, config.bus.protocol,
+                              config.joints[0].model, len(config.joints), config.bus.baudrate, read_back=True)
+        except ValueError as exc:
+            raise ConfigError(config.path, "gait.rate_hz", str(exc)) from None
+
+    load_robot_config(resolve_config(name), extra_checks=[bus_can_carry_rate])
+    slow = shipped_text(name).replace("baudrate = 1000000", "baudrate = 9600")
+    with pytest.raises(ConfigError, match="gait.rate_hz"):
+        path = tmp_path / "slow.toml"
+        path.write_text(slow)
+        load_robot_config(path, extra_checks=[bus_can_carry_rate])

@@ -37,6 +37,7 @@ except ModuleNotFoundError:  # Python 3.10
 DEFAULT_ROBOT = "xl430-biped"
 BACKENDS = ("dynamixel", "feetech")
 DYNAMIXEL_PROTOCOLS = (1.0, 2.0)
+FEETECH_PROTOCOL = 1.0
 # Highest usable id per backend; 254 is the broadcast id on both, Dynamixel reserves 253 too.
 MAX_SERVO_ID = {"dynamixel": 252, "feetech": 253}
 
@@ -84,10 +85,11 @@ class GaitSettings:
 
 @dataclass(frozen=True)
 class BusSettings:
-    """The serial bus. ``protocol`` is the Dynamixel protocol version (None for Feetech, which has one)."""
+    """The serial bus. ``protocol`` is the Dynamixel protocol version; Feetech buses always get 1.0,
+    the one (Dynamixel-1.0-shaped) protocol Feetech servos speak (servo_models lists them as (1.0,))."""
 
     backend: str
-    protocol: float | None
+    protocol: float
     port: str
     baudrate: int
     torque_off_on_exit: bool = False
@@ -141,6 +143,11 @@ class RobotConfig:
     def ids(self) -> tuple[int, ...]:
         """Servo ids in joint order."""
         return tuple(j.id for j in self.joints)
+
+    @property
+    def models_by_id(self) -> dict[int, ServoModel]:
+        """Servo model per id, in joint order (what the bus backends take as ``models``)."""
+        return {j.id: j.model for j in self.joints}
 
     def joint(self, name: str) -> JointConfig:
         for j in self.joints:
@@ -345,13 +352,13 @@ class _Reader:
         backend = self.string(t, "backend", f, f"one of {', '.join(map(repr, BACKENDS))}")
         if backend not in BACKENDS:
             raise self.fail("bus.backend", f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
-        protocol: float | None = None
+        protocol = FEETECH_PROTOCOL
         if backend == "dynamixel":
             allowed = " or ".join(str(p) for p in DYNAMIXEL_PROTOCOLS)
             protocol = self.number(t, "protocol", f)
             if protocol not in DYNAMIXEL_PROTOCOLS:
                 raise self.fail("bus.protocol", f"unknown Dynamixel protocol {protocol} (allowed: {allowed})")
-        # Feetech servos speak one protocol; a protocol key there is accepted and ignored.
+        # Feetech servos speak one protocol; a protocol key there is accepted and ignored (always 1.0).
         port = self.string(t, "port", f, "a serial port name, e.g. '/dev/ttyUSB0' or 'COM3'")
         baudrate = self.integer(t, "baudrate", f, "a positive integer (bits per second)")
         if baudrate <= 0:
@@ -395,7 +402,7 @@ class _Reader:
             fitting = [m.name for m in SERVO_MODELS.values() if m.family == bus.backend]
             raise self.fail(f"{f}.model", f"{model_name} is a {model.family} servo but bus.backend is "
                                           f"{bus.backend!r} (allowed: {', '.join(fitting)})")
-        if bus.protocol is not None and bus.protocol not in model.protocols:
+        if bus.protocol not in model.protocols:
             spoken = ", ".join(str(p) for p in model.protocols)
             raise self.fail("bus.protocol", f"{model_name} ({f}) does not speak protocol {bus.protocol} "
                                             f"(it speaks {spoken})")
