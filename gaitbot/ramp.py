@@ -1,4 +1,4 @@
-"""Rest-to-rest ramps between two poses in servo ticks: the start ramp and the safe stop.
+"""Ramps in servo ticks: rest-to-rest between two poses (start ramp), and braking (safe stop).
 
 Pure numpy, no I/O. All joints move together on one normalised trapezoidal velocity
 profile (constant acceleration, cruise, constant deceleration), so they leave and
@@ -22,7 +22,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["ramp_ticks"]
+__all__ = ["ramp_ticks", "brake_ticks", "stop_ticks"]
 
 
 def ramp_ticks(from_ticks: ArrayLike, to_ticks: ArrayLike, max_velocity_ticks_per_s: float,
@@ -51,7 +51,7 @@ def ramp_ticks(from_ticks: ArrayLike, to_ticks: ArrayLike, max_velocity_ticks_pe
 
     # Margins for rounding to whole ticks (see module docstring), capped at half the limit.
     velocity = max_velocity_ticks_per_s - min(1.0 / period_s, max_velocity_ticks_per_s / 2)
-    accel = max_accel_ticks_per_s2 - min(2.0 / period_s**2, max_accel_ticks_per_s2 / 2)
+    accel = _accel_with_rounding_margin(max_accel_ticks_per_s2, period_s)
 
     progress = _trapezoid_progress(distance, velocity, accel, period_s)
     frames = np.rint(start + progress[:, None] * delta[None, :]).astype(np.int64)
@@ -84,3 +84,55 @@ def _trapezoid_progress(distance: float, velocity: float, accel: float, period_s
     progress = np.clip(position / distance, 0.0, 1.0)
     progress[-1] = 1.0
     return progress
+
+
+def _accel_with_rounding_margin(max_accel_ticks_per_s2: float, period_s: float) -> float:
+    return max_accel_ticks_per_s2 - min(2.0 / period_s**2, max_accel_ticks_per_s2 / 2)
+
+
+def brake_ticks(previous_ticks: ArrayLike, last_ticks: ArrayLike, max_accel_ticks_per_s2: float,
+                period_s: float) -> np.ndarray:
+    """Frames (M, J) bringing every joint from its current velocity to rest at the acceleration limit.
+
+    The velocity is taken from the last two frames sent, one period apart. Each joint brakes
+    on its own at full deceleration. Joints are not synchronised here, because the shortest
+    stop is what matters: it overshoots the last pose by v^2 / (2 a). A trajectory that keeps
+    within its joint limits under the same acceleration limit always has that much room,
+    since it must itself be able to stop before a limit it is moving towards. (The
+    rounding margin makes the planned deceleration a little lower than ``max_accel``, so the
+    overshoot is a little longer: v^2 / (2 (a - 2 ticks/period^2)).)
+    Empty when no joint is moving, or none moves a whole tick while stopping.
+    """
+    previous = np.rint(np.asarray(previous_ticks, dtype=np.float64).reshape(-1))
+    last = np.rint(np.asarray(last_ticks, dtype=np.float64).reshape(-1))
+    if previous.shape != last.shape:
+        raise ValueError(f"previous_ticks has {previous.size} joints but last_ticks has {last.size}")
+    if not (max_accel_ticks_per_s2 > 0 and period_s > 0):
+        raise ValueError(f"max_accel_ticks_per_s2 and period_s must be > 0, got {max_accel_ticks_per_s2}, {period_s}")
+    velocity = (last - previous) / period_s
+    accel = _accel_with_rounding_margin(max_accel_ticks_per_s2, period_s)
+    stop_time_s = np.abs(velocity) / accel
+    longest_s = float(np.max(stop_time_s, initial=0.0))
+    if longest_s == 0.0:
+        return np.empty((0, last.size), dtype=np.int64)
+    count = max(1, math.ceil(longest_s / period_s - 1e-9))
+    t = np.minimum(np.arange(1, count + 1)[:, None] * period_s, stop_time_s[None, :])
+    position = last + velocity * t - 0.5 * np.sign(velocity) * accel * t**2
+    frames = np.rint(position).astype(np.int64)
+    if (frames == last).all():
+        return np.empty((0, last.size), dtype=np.int64)  # the stop is shorter than a tick: nothing to send
+    return frames
+
+
+def stop_ticks(previous_ticks: ArrayLike, last_ticks: ArrayLike, stand_ticks: ArrayLike,
+               max_velocity_ticks_per_s: float, max_accel_ticks_per_s2: float, period_s: float) -> np.ndarray:
+    """The safe stop: brake from the current motion, then ramp at rest to ``stand_ticks``.
+
+    Acceleration stays within the limit from the motion already under way (the last two
+    frames) through to standing, which a ramp starting "from rest" at the last pose would
+    not do: a joint moving at v would be stopped within one frame, at v / period.
+    """
+    brake = brake_ticks(previous_ticks, last_ticks, max_accel_ticks_per_s2, period_s)
+    rest = brake[-1] if len(brake) else np.rint(np.asarray(last_ticks, dtype=np.float64)).reshape(-1)
+    ramp = ramp_ticks(rest, stand_ticks, max_velocity_ticks_per_s, max_accel_ticks_per_s2, period_s)
+    return np.concatenate([brake, ramp]) if len(brake) else ramp

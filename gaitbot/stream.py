@@ -35,10 +35,10 @@ from numpy.typing import ArrayLike
 
 from gaitbot.bus.base import Bus, BusError
 from gaitbot.clock import Clock, MonotonicClock, VirtualClock
-from gaitbot.ramp import ramp_ticks
+from gaitbot.ramp import brake_ticks, ramp_ticks, stop_ticks
 
 __all__ = [
-    "Clock", "MonotonicClock", "VirtualClock", "ramp_ticks",
+    "Clock", "MonotonicClock", "VirtualClock", "ramp_ticks", "brake_ticks", "stop_ticks",
     "StreamStats", "Streamer", "MissingServosError", "Terminated", "prepare",
     "SessionResult", "walk_session", "latency_timer_warning",
     "LATE_THRESHOLD_S", "EXIT_CODES",
@@ -169,8 +169,9 @@ class Streamer:
     on_frame(k, stats) is called after frame k went out, in the loop's own time: keep it
     to reading the cheap fields of :class:`StreamStats` and printing now and then.
 
-    After ``run`` returns or raises, ``stats`` holds the figures so far and
-    ``last_sent_ticks`` the last frame whose write was started (None before the first).
+    After ``run`` returns or raises, ``stats`` holds the figures so far,
+    ``last_sent_ticks`` the last frame whose write was started (None before the first) and
+    ``previous_sent_ticks`` the one before it (the safe stop's velocity estimate).
     A write that was interrupted may or may not have reached the servos, so the safe stop
     starts from that frame: it is at most one planned step away from either possibility.
     """
@@ -194,6 +195,7 @@ class Streamer:
         self.cpu_time_s = cpu_time_s
         self.stats = StreamStats(period_s=self.period_s, late_threshold_s=late_threshold_s)
         self.last_sent_ticks: np.ndarray | None = None
+        self.previous_sent_ticks: np.ndarray | None = None
 
     def run(self, frames: ArrayLike) -> StreamStats:
         """Stream ``frames`` (N, len(ids)) of int ticks; return their timing."""
@@ -212,7 +214,7 @@ class Streamer:
                 clock.sleep_until(max(deadline_s, earliest_s))
                 send_s = clock.now()
                 work_cpu_start = cpu()
-                self.last_sent_ticks = frames[k]
+                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frames[k]
                 # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
                 # time: converting a whole one-hour walk up front would take ~100 MB.
                 bus.write_goal_ticks(dict(zip(ids, frames[k].tolist())))
@@ -331,18 +333,21 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
     Ways out:
       * completed (0): the trajectory should end standing. If its last frame is not
         ``stand_ticks``, a final ramp takes the robot there.
-      * interrupted (130, Ctrl-C) / terminated (143, SIGTERM): streaming stops; a ramp
-        from the last sent pose to ``stand_ticks`` within the limits. A second Ctrl-C or
-        SIGTERM during that ramp abandons it.
+      * interrupted (130, Ctrl-C) / terminated (143, SIGTERM): streaming stops; the safe
+        stop (:func:`~gaitbot.ramp.stop_ticks`) brakes the motion under way at the
+        acceleration limit, then ramps to ``stand_ticks`` within the limits. A second
+        Ctrl-C or SIGTERM during it abandons it.
       * bus_error (1): one attempt at the ramp to stand. The first failing bus call ends it,
         so a dead bus costs one bounded timeout, never a hang. The error is in ``error``.
     In every case, torque goes off if ``torque_off_on_exit``, and the bus is closed in a
     ``finally`` so that a recording made by the bus is flushed and readable. Other
     exceptions (bugs) get the same safe stop and are then re-raised.
 
-    The stop ramp starts from rest at the last sent pose. A joint moving at walking speed
-    is therefore stopped within one frame (the step from the last walk frame to the first
-    ramp frame). At gait speeds that step is at most one frame of the limit-checked gait.
+    The stop starts from the motion under way: velocity from the last two frames sent.
+    Braking each joint at the acceleration limit overshoots the last pose by v^2 / (2 a),
+    which a trajectory checked against the same limits always has room for. Stopping dead
+    at the last pose would decelerate at v / period instead, several times the limit at
+    walking speeds.
 
     handle_sigterm: install a SIGTERM handler that raises :class:`Terminated` (main
     thread only; the previous handler is restored on return).
@@ -356,6 +361,10 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
 
     def ramp(from_ticks: np.ndarray, to_ticks: np.ndarray) -> np.ndarray:
         return ramp_ticks(from_ticks, to_ticks, max_velocity_ticks_per_s, max_accel_ticks_per_s2, period_s)
+
+    def stop(previous_ticks: np.ndarray, last_ticks: np.ndarray) -> np.ndarray:
+        return stop_ticks(previous_ticks, last_ticks, stand, max_velocity_ticks_per_s, max_accel_ticks_per_s2,
+                          period_s)
 
     def streamer(callback=None) -> Streamer:
         return Streamer(bus, ids, period_s, clock, callback)
@@ -373,16 +382,16 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             bus.set_torque(ids, True)
             state.run(streamer(), ramp(present, walk[0]))
             state.run(streamer(on_frame), walk, is_walk=True)
-            state.run(streamer(), ramp(walk[-1], stand))
+            state.run(streamer(), stop(walk[-2] if len(walk) > 1 else walk[-1], walk[-1]))
             outcome, error = "completed", None
         except (KeyboardInterrupt, Terminated) as exc:
             outcome, error = ("terminated" if isinstance(exc, Terminated) else "interrupted"), None
-            state.safe_stop(streamer, ramp, stand)
+            state.safe_stop(streamer, stop)
         except BusError as exc:
             outcome, error = "bus_error", exc
-            state.safe_stop(streamer, ramp, stand)
+            state.safe_stop(streamer, stop)
         except Exception:
-            state.safe_stop(streamer, ramp, stand)
+            state.safe_stop(streamer, stop)
             state.finish(bus, ids, torque_off_on_exit)
             raise
         state.finish(bus, ids, torque_off_on_exit)
@@ -406,6 +415,7 @@ class _SessionState:
         self.torque_on = False
         self.torque_off = False
         self.last_sent: np.ndarray | None = None
+        self.previous_sent: np.ndarray | None = None
         self.walk_stats: StreamStats | None = None
         self.notes: list[str] = []
 
@@ -414,19 +424,22 @@ class _SessionState:
             stats = streamer.run(frames)
         finally:
             if streamer.last_sent_ticks is not None:
+                before = streamer.previous_sent_ticks
+                self.previous_sent = before if before is not None else self.last_sent
                 self.last_sent = streamer.last_sent_ticks
             if is_walk:
                 self.walk_stats = streamer.stats
         if is_walk:
             self.walk_stats = stats
 
-    def safe_stop(self, streamer: Callable[[], Streamer], ramp: Callable[[np.ndarray, np.ndarray], np.ndarray],
-                  stand: np.ndarray) -> None:
-        """Ramp from the last sent pose to stand, once; give up on a bus error or a second signal."""
+    def safe_stop(self, streamer: Callable[[], Streamer],
+                  stop: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> None:
+        """Brake and ramp from the last sent pose to stand, once; give up on a bus error or a second signal."""
         if not self.torque_on or self.last_sent is None:
             return  # nothing moved: the robot is where it was
+        previous = self.previous_sent if self.previous_sent is not None else self.last_sent
         try:
-            self.run(streamer(), ramp(self.last_sent, stand))
+            self.run(streamer(), stop(previous, self.last_sent))
             self.notes.append("ramped to the stand pose")
         except (KeyboardInterrupt, Terminated):
             self.notes.append("stop ramp abandoned on a second interrupt")

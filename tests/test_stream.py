@@ -17,7 +17,7 @@ import pytest
 
 from gaitbot.bus.base import Bus, BusError, ServoTimeout
 from gaitbot.clock import MonotonicClock, VirtualClock
-from gaitbot.ramp import ramp_ticks
+from gaitbot.ramp import brake_ticks, ramp_ticks, stop_ticks
 from gaitbot.stream import (
     EXIT_CODES, MissingServosError, Streamer, latency_timer_warning, prepare, walk_session,
 )
@@ -98,9 +98,12 @@ class FakeBus(Bus):
 
 
 def assert_within_limits(frames: np.ndarray, before: np.ndarray, max_velocity: float, max_accel: float,
-                         period_s: float = PERIOD_S, after: np.ndarray | None = None) -> None:
-    """Finite-difference velocity and acceleration of integer frames, starting from rest at ``before``."""
-    padded = [before, before, *frames] + ([after, after] if after is not None else [])
+                         period_s: float = PERIOD_S, after: np.ndarray | None = None,
+                         moving_from: np.ndarray | None = None) -> None:
+    """Finite-difference velocity and acceleration of integer frames, starting from rest at ``before``
+    (or, with ``moving_from``, in motion: ``moving_from`` then ``before`` were the two frames before)."""
+    first = before if moving_from is None else moving_from
+    padded = [first, before, *frames] + ([after, after] if after is not None else [])
     path = np.array(padded, dtype=np.float64)
     velocity = np.diff(path, axis=0) / period_s
     accel = np.diff(path, n=2, axis=0) / period_s**2
@@ -322,6 +325,32 @@ def test_ramp_with_limits_below_tick_resolution_stays_within_one_tick_of_quantis
     assert_within_limits(frames, start, max_velocity + 1 / PERIOD_S, max_accel + 2 / PERIOD_S**2, after=target)
 
 
+def test_brake_stops_each_joint_within_the_acceleration_limit():
+    previous, last = np.array([1000, 3000, 2000, 500]), np.array([1020, 2970, 2000, 540])  # ticks per frame
+    max_accel = 30_000.0
+    frames = brake_ticks(previous, last, max_accel, PERIOD_S)
+    # from the motion under way to rest, and rest held after
+    assert_within_limits(frames, last, np.inf, max_accel, after=frames[-1], moving_from=previous)
+    # each joint keeps going its own way and stops no further than v^2 / (2 a) (planned deceleration, + rounding)
+    velocity = (last - previous) / PERIOD_S
+    travel = (frames[-1] - last) * np.sign(velocity)
+    assert (travel >= 0).all()
+    assert (travel <= velocity**2 / (2 * (max_accel - 2 / PERIOD_S**2)) + 0.5).all()
+    assert (frames[:, 2] == 2000).all()  # a joint at rest stays put
+
+
+def test_brake_is_empty_at_rest_or_below_a_tick_of_motion():
+    assert brake_ticks([5, 6], [5, 6], 30_000.0, PERIOD_S).shape == (0, 2)
+    assert brake_ticks([5, 6], [6, 6], 30_000.0, PERIOD_S).shape == (0, 2)  # stops within a fraction of a tick
+
+
+def test_stop_brakes_then_ramps_to_stand_within_limits():
+    previous, last, stand = np.array([1500, 2500]), np.array([1530, 2480]), np.array([2048, 2048])
+    frames = stop_ticks(previous, last, stand, VMAX, AMAX, PERIOD_S)
+    np.testing.assert_array_equal(frames[-1], stand)
+    assert_within_limits(frames, last, VMAX, AMAX, after=stand, moving_from=previous)
+
+
 def test_ramp_rejects_bad_input():
     with pytest.raises(ValueError):
         ramp_ticks([0, 0], [10], 100.0, 100.0, PERIOD_S)
@@ -337,10 +366,15 @@ STAND = np.array([2048, 2048, 2048, 2048])
 
 
 def gait_frames(count: int = 120) -> np.ndarray:
-    """A smooth gait-like trajectory that starts and ends at STAND, well within the limits."""
+    """A smooth gait-like trajectory from STAND to STAND, within the limits but fast.
+
+    Peak speed 600 * pi / 2 s = 942 ticks/s (16 ticks a frame): stopping that dead in one
+    frame would be 56,000 ticks/s^2, nearly twice AMAX, so the stop tests can tell braking
+    from stopping dead.
+    """
     t = np.arange(count) * PERIOD_S
     phase = 2 * np.pi * t / (count * PERIOD_S)
-    amplitude = np.array([120, -80, 60, -100])
+    amplitude = np.array([600, -500, 400, -600])
     return np.rint(STAND + amplitude * (1 - np.cos(phase))[:, None] / 2).astype(np.int64)
 
 
@@ -381,6 +415,12 @@ def test_session_with_missing_servos_moves_nothing_and_closes():
     assert bus.closed
 
 
+def test_the_test_gait_is_within_limits():
+    walk = gait_frames()
+    assert_within_limits(walk, STAND, VMAX, AMAX, after=STAND)
+    assert np.abs(np.diff(walk, axis=0)).max() / PERIOD_S > 900  # fast enough to need braking
+
+
 def test_session_completed_ramps_in_walks_and_ends_standing():
     clock = VirtualClock(bus_call_cost_s=0.002)
     bus = start_pose_bus(clock)
@@ -415,12 +455,12 @@ def test_session_keeps_torque_on_when_asked():
 def test_session_ramps_to_stand_when_trajectory_ends_elsewhere():
     clock = VirtualClock()
     bus = start_pose_bus(clock)
-    walk = gait_frames()[:60]  # stops half way, away from STAND
+    walk = gait_frames()[:45]  # ends away from STAND, still moving at 70 % of peak speed
     result = session(bus, clock, frames=walk)
     written = bus.write_ticks()
     np.testing.assert_array_equal(written[-1], STAND)
     tail = written[len(written) - 1 - np.flatnonzero((written[::-1] == walk[-1]).all(axis=1))[0] + 1:]
-    assert_within_limits(tail, walk[-1], VMAX, AMAX, after=STAND)
+    assert_within_limits(tail, walk[-1], VMAX, AMAX, after=STAND, moving_from=walk[-2])
     assert result.reached_stand
 
 
@@ -448,13 +488,16 @@ def interrupt_at_walk_frame(k: int, exc_factory):
     return raise_at_walk_frames({k: exc_factory})
 
 
-def check_stop_ramp(bus: FakeBus, interrupted_ticks: np.ndarray, stop_writes: np.ndarray) -> None:
-    """Writes after the interruption: within limits from the interrupted pose, ending at STAND,
-    each joint between where it was and STAND (no further walk frames)."""
+def check_stop_ramp(previous_ticks: np.ndarray, interrupted_ticks: np.ndarray, stop_writes: np.ndarray) -> None:
+    """Writes after the interruption: within limits from the motion under way (the last two
+    frames), ending at STAND, each joint between where it was and STAND except for the braking
+    overshoot v^2 / (2 a) (so no further walk frames)."""
     np.testing.assert_array_equal(stop_writes[-1], STAND)
-    assert_within_limits(stop_writes, interrupted_ticks, VMAX, AMAX, after=STAND)
-    low = np.minimum(interrupted_ticks, STAND)
-    high = np.maximum(interrupted_ticks, STAND)
+    assert_within_limits(stop_writes, interrupted_ticks, VMAX, AMAX, after=STAND, moving_from=previous_ticks)
+    velocity = (interrupted_ticks - previous_ticks) / PERIOD_S
+    overshoot = velocity**2 / (2 * (AMAX - 2 / PERIOD_S**2)) + 1  # the planner's deceleration, plus rounding
+    low = np.minimum(interrupted_ticks, STAND) - overshoot
+    high = np.maximum(interrupted_ticks, STAND) + overshoot
     assert ((stop_writes >= low) & (stop_writes <= high)).all()
 
 
@@ -472,7 +515,7 @@ def test_ctrl_c_ramps_to_stand_and_exits_130():
     assert result.walk_stats.frames == k
     # the interrupted write did not reach the fake bus; the stop starts from that frame
     stop_writes = split_at_interrupt(bus, walk, k)
-    check_stop_ramp(bus, walk[k], stop_writes)
+    check_stop_ramp(walk[k - 1], walk[k], stop_writes)
     assert result.reached_stand and result.torque_off
     assert bus.names()[-2:] == ["set_torque", "close"]
 
@@ -507,7 +550,7 @@ def test_sigterm_ramps_to_stand_exits_143_and_restores_the_old_handler():
         signal.signal(signal.SIGTERM, previous)
     assert called == []  # our handler took it, not the sentinel
     assert result.outcome == "terminated" and result.exit_code == 143
-    check_stop_ramp(bus, walk[k], split_at_interrupt(bus, walk, k))
+    check_stop_ramp(walk[k - 1], walk[k], split_at_interrupt(bus, walk, k))
     assert result.torque_off and bus.closed
 
 
@@ -538,6 +581,7 @@ def test_dead_bus_gives_exit_1_without_hanging():
 
     def fail():
         hook_state["bus"].die()
+        hook_state["failed_call"] = len(hook_state["bus"].calls) - 1
         raise ServoTimeout("servo 3 did not answer", servo_id=3)
 
     hook, walk = interrupt_at_walk_frame(k, fail)
@@ -548,14 +592,15 @@ def test_dead_bus_gives_exit_1_without_hanging():
     assert result.outcome == "bus_error" and result.exit_code == 1
     assert isinstance(result.error, ServoTimeout) and result.error.servo_id == 3
     # after the failure: one write attempt (the stop ramp gives up at once), one torque-off attempt, close
-    failure = max(i for i, c in enumerate(bus.calls) if c[0] == "write" and c[2] == dict(zip(IDS, walk[k].tolist())))
+    failure = hook_state["failed_call"]
+    assert bus.calls[failure][2] == dict(zip(IDS, walk[k].tolist()))
     assert bus.names()[failure + 1:] == ["write", "set_torque", "close"]
     assert not result.torque_off and not result.reached_stand
     assert "servo 3" in result.message()
 
 
 def test_transient_bus_error_still_ramps_to_stand():
-    k = 50
+    k = 20
 
     def fail():
         raise BusError("checksum error")
@@ -565,7 +610,7 @@ def test_transient_bus_error_still_ramps_to_stand():
     bus = start_pose_bus(clock, on_write=hook)
     result = session(bus, clock)
     assert result.outcome == "bus_error" and result.exit_code == 1
-    check_stop_ramp(bus, walk[k], split_at_interrupt(bus, walk, k))
+    check_stop_ramp(walk[k - 1], walk[k], split_at_interrupt(bus, walk, k))
     assert result.reached_stand and result.torque_off and bus.closed
 
 
