@@ -1,0 +1,170 @@
+"""The walker of seed 000's Algorithm 2: frames every 1/rate s from a queue of step lengths.
+
+The same segments serve both uses:
+- offline: ``generate_walk`` evaluates each segment on all its frames at once (vectorised);
+- online: ``OnlineWalker`` plans a step when it is appended (a few milliseconds), and
+  ``next_frame`` then hands out one precomputed frame: constant work per frame, and steps may
+  be appended while walking. If the queue runs dry the walker closes the feet and stands,
+  which is the safe thing for a robot.
+
+A walk starts standing with feet together (zero step length), takes the queued steps, closes
+the trailing foot beside the leading one (a zero-length step) and stands (seed 000 section 2.4).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from .boulic import TABLE2_CYCLE_S
+from .geometry import LegGeometry
+from .segments import CrouchSegment, GaitContext, SettleSegment, StepSegment, WalkState
+from .step_length import StepLengthError, StepLengthInverse
+from .trajectory import HeelStrike, Trajectory
+
+
+@dataclass(frozen=True)
+class WalkSettings:
+    """Gait settings; lengths in the geometry's unit (metres for a robot).
+
+    cycle_s: duration of a cycle (two steps), fixed as in seed 000 (Table 2: 1.346 s); rounded
+    so that a step is a whole number of frames.
+    clearance: least height of the whole swing sole from 20% to 80% of each swing.
+    intermediate_steps: m of eq. 14, intermediate step lengths between consecutive steps.
+    crouch_knee_deg: knee bend of the start and end crouch (see segments.py for why).
+    settle_s: duration of the stand -> crouch and crouch -> stand phases.
+    """
+
+    cycle_s: float = TABLE2_CYCLE_S
+    rate_hz: float = 60.0
+    clearance: float = 0.02
+    intermediate_steps: int = 2
+    crouch_knee_deg: float = 25.0
+    settle_s: float = 0.5
+
+    def __post_init__(self) -> None:
+        for name in ("cycle_s", "rate_hz", "settle_s", "crouch_knee_deg"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a positive number, got {value!r}")
+        if not (math.isfinite(self.clearance) and self.clearance >= 0):
+            raise ValueError(f"clearance must be 0 or more, got {self.clearance!r}")
+        if not (isinstance(self.intermediate_steps, int) and 0 <= self.intermediate_steps <= 20):
+            raise ValueError(f"intermediate_steps must be an integer from 0 to 20, got {self.intermediate_steps!r}")
+
+
+_INVERSE_CACHE: dict[tuple, StepLengthInverse] = {}
+
+
+def make_context(geometry: LegGeometry, settings: WalkSettings = WalkSettings()) -> GaitContext:
+    """Build (and cache) what every segment of a walk needs."""
+    step_frames = max(4, round(settings.cycle_s / 2.0 * settings.rate_hz))
+    cycle_s = 2.0 * step_frames / settings.rate_hz
+    key = (geometry, cycle_s)
+    if key not in _INVERSE_CACHE:
+        _INVERSE_CACHE[key] = StepLengthInverse.build(geometry, cycle_s)
+    return GaitContext(
+        geometry=geometry,
+        inverse=_INVERSE_CACHE[key],
+        rate_hz=settings.rate_hz,
+        step_frames=step_frames,
+        clearance=settings.clearance,
+        intermediate_steps=settings.intermediate_steps,
+        crouch_knee_rad=math.radians(settings.crouch_knee_deg),
+        settle_frames=max(2, round(settings.settle_s * settings.rate_hz)),
+    )
+
+
+def validate_steps(ctx: GaitContext, step_lengths) -> list[float]:
+    """Check a list of step lengths (metres); raise StepLengthError naming the bad one."""
+    steps = list(step_lengths)
+    if not steps:
+        raise StepLengthError("no steps given: give at least one step length")
+    return [ctx.inverse.validate(sl, what=f"step {i + 1} length") for i, sl in enumerate(steps)]
+
+
+class OnlineWalker:
+    """Frame-by-frame walker. ``append_step`` plans; ``next_frame`` returns (t_s, angles_rad(6), root(2)).
+
+    Returns None after the final standing frame.
+    """
+
+    def __init__(self, geometry: LegGeometry, settings: WalkSettings = WalkSettings(), anchor: float = 0.0) -> None:
+        self.ctx = make_context(geometry, settings)
+        self.segments: list = []
+        self.heel_strikes: list[HeelStrike] = []
+        self._frames: deque = deque()
+        self._frame_index = 0
+        self._planned_frames = 0
+        self._finished = False
+        first = CrouchSegment(self.ctx, anchor, bend=True)
+        self._push(first)
+        self._state = first.end_state()
+
+    @property
+    def period_s(self) -> float:
+        return 1.0 / self.ctx.rate_hz
+
+    @property
+    def finished(self) -> bool:
+        return self._finished
+
+    def append_step(self, step_length: float) -> StepSegment:
+        """Queue one step of ``step_length`` metres (heel strike that far beyond the previous one)."""
+        if self._finished:
+            raise RuntimeError("the walk has already been closed; start a new walker")
+        sl = self.ctx.inverse.validate(step_length, what="step length")
+        segment = StepSegment(self.ctx, self._state, sl)
+        self._push(segment)
+        strike_t = self._planned_frames / self.ctx.rate_hz
+        self.heel_strikes.append(HeelStrike(strike_t, "right" if segment.state.stance_left else "left",
+                                            segment.foothold))
+        self._state = segment.end_state()
+        return segment
+
+    def finish(self) -> None:
+        """Close the trailing foot beside the leading one, settle and stand."""
+        if self._finished:
+            return
+        if self._state.step_length != 0.0 or len(self.heel_strikes) == 0:
+            self.append_step(0.0)
+        settle = SettleSegment(self.ctx, self._state)
+        self._push(settle)
+        last = CrouchSegment(self.ctx, self._state.anchor_stance, bend=False)
+        self._push(last)
+        angles, root = last.evaluate(1.0)
+        self._frames.append((angles[0], root[0]))
+        self._planned_frames += 1
+        self._finished = True
+
+    def _push(self, segment) -> None:
+        self.segments.append(segment)
+        angles, root = segment.evaluate(np.arange(segment.n_frames) / segment.n_frames)
+        self._frames.extend(zip(angles, root))
+        self._planned_frames += segment.n_frames
+
+    def next_frame(self):
+        """The next frame (t_s, angles_rad (6,), root_m (2,)), or None when the walk is over."""
+        if not self._frames and not self._finished:
+            self.finish()  # queue ran dry: close the feet and stand
+        if not self._frames:
+            return None
+        angles, root = self._frames.popleft()
+        t = self._frame_index / self.ctx.rate_hz
+        self._frame_index += 1
+        return t, angles, root
+
+
+def generate_walk(geometry: LegGeometry, step_lengths, settings: WalkSettings = WalkSettings()) -> Trajectory:
+    """The whole walk as arrays: standing, the given steps, closing step, standing."""
+    walker = OnlineWalker(geometry, settings)
+    for sl in validate_steps(walker.ctx, step_lengths):
+        walker.append_step(sl)
+    walker.finish()
+    angles = np.array([f[0] for f in walker._frames])
+    root = np.array([f[1] for f in walker._frames])
+    t = np.arange(len(angles)) / walker.ctx.rate_hz
+    return Trajectory(t, angles, root, tuple(walker.heel_strikes))
