@@ -373,8 +373,8 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
     state = _SessionState()
     try:
         try:
+            state.opened = True  # close even if open fails halfway: a recording may already be started
             bus.open()
-            state.opened = True
             present = prepare(bus, ids)
             bus.write_goal_ticks(dict(zip(ids, present.tolist())))
             state.last_sent = present

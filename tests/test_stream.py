@@ -399,6 +399,22 @@ def test_prepare_names_every_missing_id():
     assert "servos 2, 5 did not answer" in str(info.value)
 
 
+def test_session_closes_the_bus_even_when_open_fails():
+    from gaitbot.bus.base import PortError
+
+    clock = VirtualClock()
+
+    class NoPort(FakeBus):
+        def open(self):
+            super().open()
+            raise PortError("cannot open serial port /dev/ttyUSB9")
+
+    bus = NoPort(clock)
+    result = session(bus, clock)
+    assert result.outcome == "bus_error" and result.exit_code == 1 and isinstance(result.error, PortError)
+    assert bus.names() == ["open", "close"]
+
+
 def test_prepare_returns_present_ticks_in_id_order():
     clock = VirtualClock()
     bus = FakeBus(clock, present={1: 11, 2: 22, 3: 33, 4: 44})
