@@ -1,1 +1,18 @@
-"""The gait room: pure numpy, no I/O but the Trajectory file format."""
+"""The gait room: pure numpy, no I/O but the Trajectory file format.
+
+Entry points: ``generate_walk`` (offline, whole trajectory), ``OnlineWalker`` (frame by frame),
+``StepLengthInverse`` (step length <-> RV), ``steps_for_distance`` and ``perturb_steps``.
+"""
+
+from .geometry import TABLE1_LEG, LegGeometry
+from .planning import PlannedStep, perturb_steps, steps_for_distance
+from .segments import GaitGenerationError
+from .step_length import StepLengthError, StepLengthInverse
+from .trajectory import WALKING_JOINTS, HeelStrike, Trajectory, TrajectoryFileError
+from .walker import OnlineWalker, WalkSettings, generate_walk, make_context
+
+__all__ = [
+    "TABLE1_LEG", "LegGeometry", "PlannedStep", "perturb_steps", "steps_for_distance", "GaitGenerationError",
+    "StepLengthError", "StepLengthInverse", "WALKING_JOINTS", "HeelStrike", "Trajectory", "TrajectoryFileError",
+    "OnlineWalker", "WalkSettings", "generate_walk", "make_context",
+]

@@ -43,6 +43,7 @@ from .step_length import StepLengthInverse
 
 _H = 1e-5  # step of the one-sided finite differences used only when planning a segment
 MIN_KNEE_RAD = np.radians(5.0)  # feet placed by IK keep at least this knee bend (away from the singularity)
+PINNED_MIN_KNEE_RAD = np.radians(10.0)  # the pinned rear foot keeps more, leaving the swing room to saturate
 CLEARANCE_WINDOW = (0.2, 0.8)  # share of each swing's duration where the clearance must hold
 
 
@@ -67,6 +68,7 @@ class GaitContext:
     intermediate_steps: int  # m of eq. 14
     crouch_knee_rad: float
     settle_frames: int
+    pitch_limit_rad: float = np.radians(20.0)
 
     @property
     def step_s(self) -> float:
@@ -116,9 +118,24 @@ def crouch_pose(geometry: LegGeometry, knee_rad):
     return np.stack([hip, knee, knee - hip], axis=-1)
 
 
-def foot_of(geometry: LegGeometry, q, scale: float = 1.0):
-    """Foot pose (ankle x, y scaled towards the hip by ``scale``; sole pitch) of leg angles q (n, 3)."""
-    return np.column_stack([ankle_in_body(geometry, q) * scale, leg_pitch(q)])
+def foot_of(geometry: LegGeometry, q, scale: float = 1.0, pitch_limit: float = np.inf):
+    """Foot pose (ankle x, y scaled towards the hip by ``scale``; sole pitch) of leg angles q (n, 3).
+
+    The pitch passes through ``saturate`` so a long robot sole never points its toe far down:
+    the model's toe-off pitch (-50 degrees and more) would hang a 12 cm foot's toe 9 cm below the
+    ankle and force the knee past 100 degrees to clear the ground."""
+    return np.column_stack([ankle_in_body(geometry, q) * scale, saturate(leg_pitch(q), pitch_limit)])
+
+
+def saturate(x, limit: float):
+    """Identity up to limit / 2 in size, then limit/2 + (limit/2) tanh(...): smooth (C2) and within +-limit."""
+    x = np.asarray(x, dtype=float)
+    if not np.isfinite(limit):
+        return x
+    knee = 0.5 * limit
+    size = np.abs(x)
+    out = np.where(size > knee, knee + knee * np.tanh((size - knee) / knee), size)
+    return np.sign(x) * out
 
 
 def angles_of(geometry: LegGeometry, foot, what: str):
@@ -242,11 +259,12 @@ class StepSegment:
     # --- the model's own feet, relative to the hip ---------------------------------------------
     def model_stance(self, u):
         u = np.atleast_1d(np.asarray(u, dtype=float))
-        return foot_of(self.ctx.geometry, self.blend.leg(u / 2.0, u), self.ctx.leg_scale)
+        return foot_of(self.ctx.geometry, self.blend.leg(u / 2.0, u), self.ctx.leg_scale, self.ctx.pitch_limit_rad)
 
     def model_other(self, u):
         u = np.atleast_1d(np.asarray(u, dtype=float))
-        return foot_of(self.ctx.geometry, self.blend.leg(u / 2.0 + 0.5, u), self.ctx.leg_scale)
+        return foot_of(self.ctx.geometry, self.blend.leg(u / 2.0 + 0.5, u), self.ctx.leg_scale,
+                       self.ctx.pitch_limit_rad)
 
     # --- planning ---------------------------------------------------------------------------
     def _plan_landing_correction(self, duration: float) -> None:
@@ -279,7 +297,7 @@ class StepSegment:
         self._reach_lowering = 0.0
         u = np.linspace(0.0, self.u_toe_off, 120)[1:]
         rel = self._pinned_target(u)[:, :2] - self.root(u)
-        need = _lowering_needed(rel, self._reach_limit)
+        need = _lowering_needed(rel, self.ctx.geometry.leg_length * crouch_leg_scale(self.ctx.geometry, PINNED_MIN_KNEE_RAD))
         bump = np.sin(np.pi * u) ** 2
         self._reach_lowering = max(0.0, float((need / bump).max()))
 
@@ -331,13 +349,17 @@ class StepSegment:
         root_rate_end = _rate_left(lambda u: self.root(u)[0], 1.0)
         end_rate = np.array([*(ankle_rate_end * pitch_rate_end - root_rate_end), pitch_rate_end])
         model = self.model_other
+        self._model_pitch_start = model(u0)[0, 2]
+        self._pitch_rate_start = start_rate[2] * span  # per unit of swing progress s
+        self._pitch_rate_end = pitch_rate_end * span
         self._d0 = start - model(u0)[0]
         self._d0_rate = (start_rate - _rate_right(lambda u: model(u)[0], u0)) * span
         self._d1 = end - model(1.0)[0]
         self._d1_rate = (end_rate - _rate_left(lambda u: model(u)[0], 1.0)) * span
         ends = (float(np.hypot(*start[:2])), float(np.hypot(*end[:2])))
         self._saturate_from = max(ends) + 1e-9 * g.leg_length
-        self._saturate_to = max(self._reach_limit, self._saturate_from + 1e-3 * g.leg_length)
+        self._saturate_to = min(max(self._reach_limit, self._saturate_from + 1e-3 * g.leg_length),
+                                g.leg_length * (1.0 - 1e-6))
         self.lift = 0.0
         s = np.linspace(0.0, 1.0, 401)
         u = u0 + s * span
@@ -355,11 +377,28 @@ class StepSegment:
                 break
             self.lift += extra
 
+    LEVEL_FROM_S, LEVEL_UNTIL_S = 0.3, 0.7  # the swing sole is level over this share of the swing
+
+    def _swing_pitch(self, s):
+        """Sole pitch over the swing: from the toe-off pitch to level, level, then to the landing pitch.
+
+        The model's own swing pitch stays toe-down (knee flexion tips the foot), which on a long
+        robot foot drags the toe or needs a tall lift; a level sole mid-swing clears the ground
+        with the least lift. Pitch and its rate match the pinned foot at toe-off and the landing."""
+        a, b = self.LEVEL_FROM_S, self.LEVEL_UNTIL_S
+        p0, r0 = self._d0[2] + self._model_pitch_start, self._pitch_rate_start
+        p1, r1 = self.landing_pitch, self._pitch_rate_end
+        rise = hermite_segment(np.clip(s / a, 0, 1), np.array([p0]), np.array([r0 * a]), np.zeros(1), np.zeros(1))[:, 0]
+        fall = hermite_segment(np.clip((s - b) / (1 - b), 0, 1), np.zeros(1), np.zeros(1), np.array([p1]),
+                               np.array([r1 * (1 - b)]))[:, 0]
+        return np.where(s < a, rise, np.where(s > b, fall, 0.0))
+
     def swing_relative(self, u):
         """Swing foot (ankle x, y relative to the hip; pitch) for u in [toe-off, 1]."""
         u = np.atleast_1d(np.asarray(u, dtype=float))
         s = (u - self.u_toe_off) / (1.0 - self.u_toe_off)
         target = self.model_other(u) + hermite_segment(s, self._d0, self._d0_rate, self._d1, self._d1_rate)
+        target[:, 2] = self._swing_pitch(s)
         target[:, 1] += self.lift * plateau(s, CLEARANCE_WINDOW[0])
         target[:, :2] = _saturate_reach(target[:, :2], self._saturate_from, self._saturate_to)
         return target

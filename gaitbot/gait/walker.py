@@ -21,6 +21,7 @@ import numpy as np
 
 from .boulic import TABLE2_CYCLE_S
 from .geometry import LegGeometry
+from .planning import PlannedStep
 from .segments import CrouchSegment, GaitContext, SettleSegment, StepSegment, WalkState
 from .step_length import StepLengthError, StepLengthInverse
 from .trajectory import HeelStrike, Trajectory
@@ -36,6 +37,7 @@ class WalkSettings:
     intermediate_steps: m of eq. 14, intermediate step lengths between consecutive steps.
     crouch_knee_deg: knee bend of the start and end crouch (see segments.py for why).
     settle_s: duration of the stand -> crouch and crouch -> stand phases.
+    pitch_limit_deg: the model's sole pitch is smoothly saturated to +- this (see segments.foot_of).
     """
 
     cycle_s: float = TABLE2_CYCLE_S
@@ -44,9 +46,10 @@ class WalkSettings:
     intermediate_steps: int = 2
     crouch_knee_deg: float = 25.0
     settle_s: float = 0.5
+    pitch_limit_deg: float = 20.0
 
     def __post_init__(self) -> None:
-        for name in ("cycle_s", "rate_hz", "settle_s", "crouch_knee_deg"):
+        for name in ("cycle_s", "rate_hz", "settle_s", "crouch_knee_deg", "pitch_limit_deg"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be a positive number, got {value!r}")
@@ -75,6 +78,7 @@ def make_context(geometry: LegGeometry, settings: WalkSettings = WalkSettings())
         intermediate_steps=settings.intermediate_steps,
         crouch_knee_rad=math.radians(settings.crouch_knee_deg),
         settle_frames=max(2, round(settings.settle_s * settings.rate_hz)),
+        pitch_limit_rad=math.radians(settings.pitch_limit_deg),
     )
 
 
@@ -96,6 +100,7 @@ class OnlineWalker:
         self.ctx = make_context(geometry, settings)
         self.segments: list = []
         self.heel_strikes: list[HeelStrike] = []
+        self.planned_steps: list[PlannedStep] = []
         self._frames: deque = deque()
         self._frame_index = 0
         self._planned_frames = 0
@@ -112,16 +117,19 @@ class OnlineWalker:
     def finished(self) -> bool:
         return self._finished
 
-    def append_step(self, step_length: float) -> StepSegment:
+    def append_step(self, step_length: float, closing: bool = False) -> StepSegment:
         """Queue one step of ``step_length`` metres (heel strike that far beyond the previous one)."""
         if self._finished:
             raise RuntimeError("the walk has already been closed; start a new walker")
         sl = self.ctx.inverse.validate(step_length, what="step length")
         segment = StepSegment(self.ctx, self._state, sl)
+        start_t = self._planned_frames / self.ctx.rate_hz
         self._push(segment)
         strike_t = self._planned_frames / self.ctx.rate_hz
-        self.heel_strikes.append(HeelStrike(strike_t, "right" if segment.state.stance_left else "left",
-                                            segment.foothold))
+        leg = "right" if segment.state.stance_left else "left"
+        self.heel_strikes.append(HeelStrike(strike_t, leg, segment.foothold))
+        self.planned_steps.append(PlannedStep(len(self.planned_steps) + 1, leg, sl, segment.rvs[-1], start_t,
+                                              strike_t, segment.foothold, closing))
         self._state = segment.end_state()
         return segment
 
@@ -130,7 +138,7 @@ class OnlineWalker:
         if self._finished:
             return
         if self._state.step_length != 0.0 or len(self.heel_strikes) == 0:
-            self.append_step(0.0)
+            self.append_step(0.0, closing=True)
         settle = SettleSegment(self.ctx, self._state)
         self._push(settle)
         last = CrouchSegment(self.ctx, self._state.anchor_stance, bend=False)
@@ -158,13 +166,24 @@ class OnlineWalker:
         return t, angles, root
 
 
-def generate_walk(geometry: LegGeometry, step_lengths, settings: WalkSettings = WalkSettings()) -> Trajectory:
-    """The whole walk as arrays: standing, the given steps, closing step, standing."""
+def plan_walk(geometry: LegGeometry, step_lengths, settings: WalkSettings = WalkSettings()) -> OnlineWalker:
+    """A closed walker holding every frame of the walk (standing, the steps, closing step, standing)."""
     walker = OnlineWalker(geometry, settings)
     for sl in validate_steps(walker.ctx, step_lengths):
         walker.append_step(sl)
     walker.finish()
-    angles = np.array([f[0] for f in walker._frames])
-    root = np.array([f[1] for f in walker._frames])
-    t = np.arange(len(angles)) / walker.ctx.rate_hz
+    return walker
+
+
+def trajectory_of(walker: OnlineWalker) -> Trajectory:
+    """All remaining frames of a closed walker as one Trajectory."""
+    frames = list(walker._frames)
+    angles = np.array([f[0] for f in frames])
+    root = np.array([f[1] for f in frames])
+    t = (walker._frame_index + np.arange(len(frames))) / walker.ctx.rate_hz
     return Trajectory(t, angles, root, tuple(walker.heel_strikes))
+
+
+def generate_walk(geometry: LegGeometry, step_lengths, settings: WalkSettings = WalkSettings()) -> Trajectory:
+    """The whole walk as arrays: standing, the given steps, closing step, standing."""
+    return trajectory_of(plan_walk(geometry, step_lengths, settings))

@@ -1,0 +1,96 @@
+"""The ``gaitbot`` command line: argparse subcommands wired to gaitbot.commands; no logic here.
+
+Bad input prints one line and exits with status 2 (a traceback only with --debug).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from gaitbot import __version__
+
+
+def _walk_inputs(p: argparse.ArgumentParser) -> None:
+    what = p.add_mutually_exclusive_group(required=False)
+    what.add_argument("--steps", help="step lengths in metres, comma separated, e.g. 0.05,0.08,0.08")
+    what.add_argument("--distance", type=float, help="distance to walk in metres (fewest equal steps)")
+    p.add_argument("--max-step", type=float, help="longest step for --distance, metres (default: the robot's max_step_m)")
+    p.add_argument("--perturb", type=float, default=0.0, metavar="SIGMA",
+                   help="add zero-mean random noise of this standard deviation (metres) to step lengths")
+    p.add_argument("--seed", type=int, help="random seed for --perturb")
+    p.add_argument("--robot", help="robot config (a .toml path or a shipped name; default xl430-biped)")
+    p.add_argument("--thigh", type=float, help="thigh length in metres (overrides the robot's leg)")
+    p.add_argument("--shank", type=float, help="shank length in metres")
+    p.add_argument("--foot", type=float, help="foot length in metres")
+    p.add_argument("--clearance", type=float, help="swing-foot clearance in metres (default: the robot's)")
+    p.add_argument("--rate", type=float, help="frame rate in Hz (default: the robot's rate_hz)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="gaitbot", description="Walking gaits for small servo bipeds.")
+    parser.add_argument("--version", action="version", version=f"gaitbot {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("plan", help="print the step plan")
+    _walk_inputs(p)
+    p.add_argument("--json", action="store_true", help="print the plan as one JSON object")
+
+    p = sub.add_parser("generate", help="write the trajectory to CSV or NPZ")
+    _walk_inputs(p)
+    p.add_argument("-o", "--output", required=True, help="walk.csv or walk.npz")
+
+    p = sub.add_parser("plot", help="draw a trajectory file to a PNG")
+    p.add_argument("file", help="trajectory (.csv or .npz)")
+    p.add_argument("-o", "--output", required=True, help="picture file, e.g. walk.png")
+    p.add_argument("--robot", help="robot config whose leg drew the trajectory (default xl430-biped)")
+    p.add_argument("--thigh", type=float)
+    p.add_argument("--shank", type=float)
+    p.add_argument("--foot", type=float)
+    p.add_argument("--clearance", type=float)
+
+    p = sub.add_parser("walk", help="walk the robot (or a dry run on the mock bus)")
+    _walk_inputs(p)
+    p.add_argument("--dry-run", action="store_true", help="use the mock bus: no hardware, exact packets")
+    p.add_argument("--realtime", action="store_true", help="pace a dry run at the real frame rate")
+    p.add_argument("--record", help="write every bus packet to this .jsonl file")
+    p.add_argument("--port", help="serial port (default: the robot config's)")
+
+    p = sub.add_parser("check", help="check a trajectory or a recorded run against the robot's limits")
+    p.add_argument("file", help="trajectory (.csv, .npz) or bus recording (.jsonl)")
+    p.add_argument("--robot", help="robot config (default xl430-biped)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.add_argument("--margin-deg", type=float, default=0.0, help="warn within this many degrees of a limit")
+
+    p = sub.add_parser("scan", help="list the servos that answer")
+    p.add_argument("--robot", help="robot config (default xl430-biped)")
+    p.add_argument("--port", help="serial port (default: the robot config's)")
+    p.add_argument("--all", action="store_true", help="ping every id, not only the configured ones")
+    p.add_argument("--dry-run", action="store_true", help="scan the mock bus")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command in ("plan", "generate", "walk") and args.steps is None and args.distance is None:
+        if args.command == "walk" and args.dry_run:
+            args.distance = 0.5  # the built-in demo: half a metre on the mock bus
+        else:
+            parser.error(f"{args.command}: give --steps or --distance")
+    from gaitbot import commands
+    from gaitbot.errors import USER_ERRORS
+
+    handler = getattr(commands, f"cmd_{args.command}")
+    try:
+        return handler(args)
+    except USER_ERRORS as exc:
+        if args.debug:
+            raise
+        print(f"gaitbot {args.command}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,138 @@
+"""What each subcommand does, given parsed arguments. Returns the process exit status."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from gaitbot.bus.factory import make_bus
+from gaitbot.bus.recording import BusRecorder
+from gaitbot.clock import MonotonicClock, VirtualClock
+from gaitbot.gait.trajectory import Trajectory
+from gaitbot.robot.calibration import angles_to_ticks, standing_ticks
+from gaitbot.session import (UsageError, joint_limits_ticks, load_robot, plan_summary, preflight,
+                             trajectory_for_robot)
+from gaitbot.stream import latency_timer_warning, walk_session
+
+
+def cmd_plan(args) -> int:
+    source, walker, _ = trajectory_for_robot(args)
+    plan = plan_summary(source, walker)
+    if args.json:
+        print(json.dumps(plan, indent=2))
+        return 0
+    print(f"{'step':>4} {'leg':>5} {'length m':>9} {'RV':>7} {'start s':>8} {'end s':>7} {'foothold m':>10}")
+    for s in plan["steps"] + ([plan["closing_step"]] if plan["closing_step"] else []):
+        label = "close" if s["closing"] else str(s["index"])
+        print(f"{label:>4} {s['leg']:>5} {s['length_m']:9.4f} {s['rv']:7.4f} {s['start_s']:8.3f} {s['end_s']:7.3f} "
+              f"{s['foothold_m']:10.4f}")
+    print(f"{plan['n_steps']} steps, {plan['total_distance_m']:.4f} m in {plan['duration_s']:.2f} s "
+          f"(cycle {plan['cycle_s']:.4f} s, {plan['rate_hz']:g} Hz, reachable step 0 to "
+          f"{plan['reachable_step_m'][1]:.4f} m, allowed up to {plan['max_step_m']:.4f} m)")
+    return 0
+
+
+def cmd_generate(args) -> int:
+    out = Path(args.output)
+    if out.suffix not in (".csv", ".npz"):
+        raise UsageError(f"-o {out}: the output must end in .csv or .npz")
+    _, walker, trajectory = trajectory_for_robot(args)
+    trajectory.save(out)
+    print(f"wrote {out}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
+          f"{len(walker.heel_strikes)} heel strikes, {trajectory.root_m[-1, 0]:.4f} m")
+    return 0
+
+
+def cmd_plot(args) -> int:
+    from gaitbot.plot import plot_trajectory  # matplotlib only when plotting
+
+    trajectory = Trajectory.load(args.file)
+    source_args = args
+    from gaitbot.session import gait_source
+
+    source = gait_source(source_args)
+    out = Path(args.output)
+    plot_trajectory(trajectory, source.geometry, out, clearance=source.settings.clearance, title=Path(args.file).name)
+    print(f"wrote {out}")
+    return 0
+
+
+def _status_line(total: int, strikes, out=sys.stderr):
+    """A cheap live status line: frame, step and late frames, rewritten in place on a terminal."""
+    if not out.isatty():
+        return None
+    times = [h.t_s for h in strikes]
+
+    def on_frame(k: int, stats) -> None:
+        if k % 6:
+            return
+        step = sum(1 for t in times if t <= k / 60.0)
+        out.write(f"\rframe {k + 1}/{total}  step {step}/{len(times)}  late {stats.late_frames}   ")
+        out.flush()
+
+    return on_frame
+
+
+def cmd_walk(args) -> int:
+    config = load_robot(args.robot)
+    args.robot = str(config.path)
+    source, walker, trajectory = trajectory_for_robot(args)
+    report = preflight(config, trajectory)
+    if not report.ok:
+        raise UsageError(f"walk refused before anything moved: {report.first_error}")
+    frames = angles_to_ticks(config, trajectory.angles_rad)
+    period = 1.0 / source.settings.rate_hz
+    port = args.port or config.bus.port
+    clock = MonotonicClock() if (not args.dry_run or args.realtime) else VirtualClock()
+    if not args.dry_run:
+        warning = latency_timer_warning(port)
+        if warning:
+            print(f"warning: {warning}", file=sys.stderr)
+    recorder = None
+    if args.record:
+        joints = {j.name: j.id for j in config.joints}
+        recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now)
+    bus = make_bus(config.bus.backend, config.bus.protocol, port, config.bus.baudrate, config.models_by_id,
+                   dry_run=args.dry_run, recorder=recorder)
+    velocity, acceleration = joint_limits_ticks(config)
+    try:
+        result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
+                              max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
+                              torque_off_on_exit=config.bus.torque_off_on_exit,
+                              on_frame=_status_line(len(frames), walker.heel_strikes))
+    finally:
+        if recorder is not None:
+            recorder.close()
+    if sys.stderr.isatty():
+        sys.stderr.write("\n")
+    mode = "dry run (mock bus)" if args.dry_run else f"{config.bus.backend} on {port}"
+    print(f"{config.name}: {mode}: {len(walker.planned_steps)} heel strikes, "
+          f"{trajectory.root_m[-1, 0]:.3f} m planned. {result.message()}")
+    if result.walk_stats is not None:
+        print(result.walk_stats.summary())
+    if args.record:
+        print(f"recording: {args.record}")
+    return result.exit_code
+
+
+def cmd_scan(args) -> int:
+    config = load_robot(args.robot)
+    port = args.port or config.bus.port
+    ids = range(0, 253) if args.all else config.ids
+    names = {j.id: j.name for j in config.joints}
+    bus = make_bus(config.bus.backend, config.bus.protocol, port, config.bus.baudrate, config.models_by_id,
+                   dry_run=args.dry_run)
+    with bus:
+        found = bus.scan(ids)
+    for servo_id in ids if not args.all else found:
+        state = "answers" if servo_id in found else "MISSING"
+        print(f"id {servo_id:3d}  {names.get(servo_id, '(not in config)'):20s} {state}")
+    missing = [i for i in config.ids if i not in found]
+    return 1 if missing else 0
+
+
+def cmd_check(args) -> int:
+    from gaitbot.check_command import run_check
+
+    return run_check(args)

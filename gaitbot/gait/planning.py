@@ -1,0 +1,58 @@
+"""Step plans: lengths from a distance, small random perturbations, and the per-step timetable.
+
+Seed 000 section 2.4 / gait-model.md section 5: given a distance, the fewest equal steps that
+cover it; small random perturbations so that the walk does not look mechanical; left and right
+steps may differ (a plain list of step lengths expresses that).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .step_length import StepLengthError
+
+
+def steps_for_distance(distance: float, max_step: float) -> list[float]:
+    """The fewest equal steps of at most ``max_step`` covering ``distance`` (same unit)."""
+    for name, value in (("distance", distance), ("maximum step", max_step)):
+        if not math.isfinite(value) or value <= 0:
+            raise StepLengthError(f"{name} must be a positive finite number, got {value!r}")
+    count = max(1, math.ceil(distance / max_step - 1e-12))
+    return [distance / count] * count
+
+
+def perturb_steps(steps, sigma: float, seed: int | None, max_step: float) -> list[float]:
+    """Add zero-mean Gaussian noise of standard deviation ``sigma`` to each step length.
+
+    The noise is centred (its mean removed) so the walk still covers the planned distance, then
+    each step is kept within [0, max_step]; with a seed the result is reproducible.
+    """
+    if not math.isfinite(sigma) or sigma < 0:
+        raise StepLengthError(f"perturbation sigma must be 0 or more, got {sigma!r}")
+    steps = np.asarray(steps, dtype=float)
+    if sigma == 0 or len(steps) == 0:
+        return steps.tolist()
+    noise = np.random.default_rng(seed).normal(0.0, sigma, len(steps))
+    if len(steps) > 1:
+        noise -= noise.mean()
+    return np.clip(steps + noise, 0.0, max_step).tolist()
+
+
+@dataclass(frozen=True)
+class PlannedStep:
+    """One heel strike of the plan. ``leg`` is the leg that swings and lands."""
+
+    index: int
+    leg: str
+    length_m: float
+    rv: float
+    start_s: float
+    end_s: float
+    foothold_m: float
+    closing: bool = False
+
+    def to_dict(self) -> dict:
+        return asdict(self)

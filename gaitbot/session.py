@@ -1,0 +1,188 @@
+"""Wiring for the commands: from arguments to a robot, a step plan, a trajectory and a bus.
+
+No numerics here: each function joins rooms (gait -> robot -> bus -> stream) the one way data
+flows. Errors for people are raised as ``UsageError`` (one line, exit status 2).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from gaitbot.bus.budget import check_rate
+from gaitbot.check import CheckReport, check_trajectory, trajectory_angles_deg
+from gaitbot.gait.geometry import LegGeometry
+from gaitbot.gait.planning import perturb_steps, steps_for_distance
+from gaitbot.gait.step_length import StepLengthError
+from gaitbot.gait.trajectory import Trajectory
+from gaitbot.gait.walker import OnlineWalker, WalkSettings, make_context, plan_walk, trajectory_of
+from gaitbot.robot.config import ConfigError, RobotConfig, default_config_path, load_robot_config, resolve_config
+from gaitbot.robot.gait_setup import leg_geometry, walk_settings
+
+
+class UsageError(ValueError):
+    """Bad input from the user: printed as one line, exit status 2, nothing sent to a servo."""
+
+
+def bus_budget_check(config: RobotConfig) -> None:
+    """Refuse a frame rate the bus cannot carry (writes plus a read-back) with margin."""
+    try:
+        check_rate(config.gait.rate_hz, config.bus.backend, config.bus.protocol, config.joints[0].model,
+                   len(config.joints), config.bus.baudrate, read_back=True)
+    except ValueError as exc:
+        raise ConfigError(config.path, "gait.rate_hz", str(exc)) from None
+
+
+def load_robot(robot: str | None) -> RobotConfig:
+    """The robot config named by ``--robot`` (a path or a shipped name), or the built-in default."""
+    try:
+        path = resolve_config(robot) if robot else default_config_path()
+        return load_robot_config(path, extra_checks=[bus_budget_check])
+    except ConfigError:
+        raise
+    except (OSError, ValueError, KeyError) as exc:
+        raise UsageError(f"--robot {robot}: {exc}") from None
+
+
+@dataclass(frozen=True)
+class GaitSource:
+    """Where a walk's geometry and settings come from, and the longest step allowed (metres)."""
+
+    geometry: LegGeometry
+    settings: WalkSettings
+    max_step_m: float
+    robot: RobotConfig | None
+
+
+def gait_source(args) -> GaitSource:
+    """Geometry and settings from ``--robot`` (or the default robot), with ``--thigh/--shank/--foot`` overrides."""
+    robot = load_robot(getattr(args, "robot", None))
+    geometry = leg_geometry(robot)
+    overrides = {k: getattr(args, k, None) for k in ("thigh", "shank", "foot")}
+    if any(v is not None for v in overrides.values()):
+        for name, value in overrides.items():
+            if value is not None and not (math.isfinite(value) and value > 0):
+                raise UsageError(f"--{name} must be a positive length in metres, got {value!r}")
+        geometry = LegGeometry(thigh=overrides["thigh"] or geometry.thigh, shank=overrides["shank"] or geometry.shank,
+                               foot=overrides["foot"] or geometry.foot, hip_width=geometry.hip_width,
+                               ankle_height=0.0 if overrides["foot"] else geometry.ankle_height)
+        robot_for_limits = None  # a custom leg is not the robot whose joint limits are configured
+    else:
+        robot_for_limits = robot
+    rate = getattr(args, "rate", None)
+    if rate is not None and not (math.isfinite(rate) and rate > 0):
+        raise UsageError(f"--rate must be a positive frame rate in Hz, got {rate!r}")
+    settings = walk_settings(robot, rate)
+    clearance = getattr(args, "clearance", None)
+    if clearance is not None:
+        if not (math.isfinite(clearance) and clearance >= 0):
+            raise UsageError(f"--clearance must be 0 or more metres, got {clearance!r}")
+        settings = WalkSettings(settings.cycle_s, settings.rate_hz, clearance)
+    reachable = make_context(geometry, settings).inverse.max_step_length
+    max_step = robot.gait.max_step_m if robot_for_limits is not None else reachable
+    return GaitSource(geometry, settings, min(max_step, reachable), robot_for_limits)
+
+
+def parse_step_list(text: str) -> list[float]:
+    """``0.3,0.4,...`` -> floats; one clear error for anything else."""
+    if text is None or not text.strip():
+        raise UsageError("--steps: empty list; give step lengths in metres, e.g. --steps 0.05,0.06,0.05")
+    values = []
+    for i, item in enumerate(text.split(","), start=1):
+        try:
+            value = float(item)
+        except ValueError:
+            raise UsageError(f"--steps: item {i} {item.strip()!r} is not a number") from None
+        if not math.isfinite(value):
+            raise UsageError(f"--steps: item {i} {item.strip()!r} is not a finite number")
+        values.append(value)
+    return values
+
+
+def step_lengths(args, source: GaitSource) -> list[float]:
+    """The requested steps (metres) from ``--steps`` or ``--distance``/``--max-step``, perturbed if asked."""
+    if getattr(args, "steps", None) is not None:
+        steps = parse_step_list(args.steps)
+    else:
+        distance = args.distance
+        if distance is None or not math.isfinite(distance) or distance <= 0:
+            raise UsageError(f"--distance must be a positive number of metres, got {distance!r}")
+        max_step = source.max_step_m if args.max_step is None else args.max_step
+        if not math.isfinite(max_step) or max_step <= 0:
+            raise UsageError(f"--max-step must be a positive number of metres, got {max_step!r}")
+        if max_step > source.max_step_m * (1 + 1e-12):
+            raise UsageError(f"--max-step {max_step:g} m is longer than this robot's longest step "
+                             f"{source.max_step_m:.4g} m")
+        steps = steps_for_distance(distance, max_step)
+    for i, value in enumerate(steps, start=1):
+        if value < 0:
+            raise UsageError(f"--steps: step {i} is {value:g} m; step lengths must be 0 or more")
+        if value > source.max_step_m * (1 + 1e-12):
+            what = "max_step_m in the robot config" if source.robot is not None else "the leg's reachable maximum"
+            raise UsageError(f"--steps: step {i} is {value:g} m, longer than {source.max_step_m:.4g} m ({what})")
+    sigma = getattr(args, "perturb", None)
+    if sigma:
+        steps = perturb_steps(steps, sigma, getattr(args, "seed", None), source.max_step_m)
+    return steps
+
+
+def build_walk(args) -> tuple[GaitSource, OnlineWalker]:
+    """A planned, closed walker for the arguments (all frames computed)."""
+    source = gait_source(args)
+    steps = step_lengths(args, source)
+    try:
+        return source, plan_walk(source.geometry, steps, source.settings)
+    except StepLengthError as exc:
+        raise UsageError(str(exc)) from None
+
+
+def plan_summary(source: GaitSource, walker: OnlineWalker) -> dict:
+    """The plan as a JSON-ready object: requested steps, the closing step, footholds and totals."""
+    steps = [s.to_dict() for s in walker.planned_steps if not s.closing]
+    closing = [s.to_dict() for s in walker.planned_steps if s.closing]
+    n_frames = walker._planned_frames
+    return {
+        "robot": source.robot.name if source.robot is not None else None,
+        "leg_length_m": source.geometry.leg_length,
+        "cycle_s": walker.ctx.cycle_s,
+        "rate_hz": walker.ctx.rate_hz,
+        "reachable_step_m": list(walker.ctx.inverse.reachable_range),
+        "max_step_m": source.max_step_m,
+        "steps": steps,
+        "closing_step": closing[0] if closing else None,
+        "heel_strikes": [{"t_s": h.t_s, "leg": h.leg, "x_m": h.x_m} for h in walker.heel_strikes],
+        "total_distance_m": walker.heel_strikes[-1].x_m if walker.heel_strikes else 0.0,
+        "n_steps": len(steps),
+        "duration_s": (n_frames - 1) / walker.ctx.rate_hz,
+        "n_frames": n_frames,
+    }
+
+
+def preflight(config: RobotConfig, trajectory: Trajectory, margin_deg: float = 0.0) -> CheckReport:
+    """The limit check ``gaitbot walk`` runs before anything moves (the same code as ``gaitbot check``)."""
+    return check_trajectory(config, trajectory.t_s, trajectory_angles_deg(config, trajectory.angles_rad), margin_deg)
+
+
+def joint_limits_ticks(config: RobotConfig) -> tuple[float, float]:
+    """The slowest joint's velocity and acceleration limits in ticks/s and ticks/s^2 (for ramps)."""
+    vel = min(math.radians(j.max_velocity_dps) * j.model.ticks_per_rad for j in config.joints)
+    acc = min(math.radians(j.max_acceleration_dps2) * j.model.ticks_per_rad for j in config.joints)
+    return vel, acc
+
+
+def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:
+    source, walker = build_walk(args)
+    return source, walker, trajectory_of(walker)
+
+
+def write_json(path: Path, obj) -> None:
+    import json
+
+    path.write_text(json.dumps(obj, indent=2) + "\n")
+
+
+def angles_summary(trajectory: Trajectory) -> np.ndarray:
+    return np.degrees(trajectory.angles_rad)
