@@ -180,12 +180,14 @@ def _assemble(stance_left: bool, q_stance, q_other, root):
 
 
 def _rate_left(f, u: float):
-    """d f / du at u from the left, second order."""
-    return (3 * f(u) - 4 * f(u - _H) + f(u - 2 * _H)) / (2 * _H)
+    """d f / du at u from the left, second order; ``f`` maps an array of u to rows."""
+    v = f(np.array([u, u - _H, u - 2 * _H]))
+    return (3 * v[0] - 4 * v[1] + v[2]) / (2 * _H)
 
 
 def _rate_right(f, u: float):
-    return (-3 * f(u) + 4 * f(u + _H) - f(u + 2 * _H)) / (2 * _H)
+    v = f(np.array([u, u + _H, u + 2 * _H]))
+    return (-3 * v[0] + 4 * v[1] - v[2]) / (2 * _H)
 
 
 class CrouchSegment:
@@ -270,13 +272,13 @@ class StepSegment:
     def _plan_landing_correction(self, duration: float) -> None:
         s = self.state
         self._delta0 = s.foot_stance - self.model_stance(0.0)[0]
-        rate0 = s.foot_rate_stance * duration - _rate_right(lambda u: self.model_stance(u)[0], 0.0)
+        rate0 = s.foot_rate_stance * duration - _rate_right(self.model_stance, 0.0)
         self._delta_rate0 = rate0 * self.DECAY_U  # per unit of the decay window
 
     def _plan_rear_correction(self, duration: float) -> None:
         s = self.state
-        model_pitch = lambda u: self.model_other(u)[0, 2]  # noqa: E731
-        self._eps0 = s.pitch_rear - model_pitch(0.0)
+        model_pitch = lambda u: self.model_other(u)[:, 2]  # noqa: E731
+        self._eps0 = s.pitch_rear - model_pitch(0.0)[0]
         self._eps_rate0 = (s.pitch_rate_rear * duration - _rate_right(model_pitch, 0.0)) * self.u_toe_off
 
     def _plan_double_support(self) -> None:
@@ -341,27 +343,27 @@ class StepSegment:
         g, u0 = self.ctx.geometry, self.u_toe_off
         span = 1.0 - u0
         start = self._pinned_relative(u0)[0]
-        start_rate = _rate_left(lambda u: self._pinned_relative(u)[0], u0)
-        pitch_rate_end = _rate_left(lambda u: self.model_other(u)[0, 2], 1.0)
+        start_rate = _rate_left(self._pinned_relative, u0)
+        pitch_rate_end = _rate_left(lambda u: self.model_other(u)[:, 2], 1.0)
         end = np.array([*(self.landing_ankle - self.root_at_strike), self.landing_pitch])
         heel_fixed = lambda p: heel_pinned_ankle(g, self.foothold, p)  # noqa: E731
         ankle_rate_end = (heel_fixed(self.landing_pitch + _H) - heel_fixed(self.landing_pitch - _H)) / (2 * _H)
-        root_rate_end = _rate_left(lambda u: self.root(u)[0], 1.0)
+        root_rate_end = _rate_left(self.root, 1.0)
         end_rate = np.array([*(ankle_rate_end * pitch_rate_end - root_rate_end), pitch_rate_end])
         model = self.model_other
         self._model_pitch_start = model(u0)[0, 2]
         self._pitch_rate_start = start_rate[2] * span  # per unit of swing progress s
         self._pitch_rate_end = pitch_rate_end * span
         self._d0 = start - model(u0)[0]
-        self._d0_rate = (start_rate - _rate_right(lambda u: model(u)[0], u0)) * span
+        self._d0_rate = (start_rate - _rate_right(model, u0)) * span
         self._d1 = end - model(1.0)[0]
-        self._d1_rate = (end_rate - _rate_left(lambda u: model(u)[0], 1.0)) * span
+        self._d1_rate = (end_rate - _rate_left(model, 1.0)) * span
         ends = (float(np.hypot(*start[:2])), float(np.hypot(*end[:2])))
         self._saturate_from = max(ends) + 1e-9 * g.leg_length
         self._saturate_to = min(max(self._reach_limit, self._saturate_from + 1e-3 * g.leg_length),
                                 g.leg_length * (1.0 - 1e-6))
         self.lift = 0.0
-        s = np.linspace(0.0, 1.0, 401)
+        s = np.linspace(0.0, 1.0, 201)
         u = u0 + s * span
         root = self.root(u)
         inside = (s >= CLEARANCE_WINDOW[0]) & (s <= CLEARANCE_WINDOW[1])
@@ -426,14 +428,14 @@ class StepSegment:
 
     def end_state(self) -> WalkState:
         duration = self.n_frames / self.ctx.rate_hz
-        stance_pitch = lambda u: float(self.stance_foot(u)[0, 2])  # noqa: E731
+        stance_pitch = lambda u: self.stance_foot(u)[:, 2]  # noqa: E731
         return WalkState(
             stance_left=not self.state.stance_left,
             anchor_stance=self.foothold,
             anchor_rear=self.state.anchor_stance,
             foot_stance=self.other_foot(1.0)[0],
-            foot_rate_stance=_rate_left(lambda u: self.other_foot(u)[0], 1.0) / duration,
-            pitch_rear=stance_pitch(1.0),
-            pitch_rate_rear=_rate_left(stance_pitch, 1.0) / duration,
+            foot_rate_stance=_rate_left(self.other_foot, 1.0) / duration,
+            pitch_rear=float(stance_pitch(1.0)[0]),
+            pitch_rate_rear=float(_rate_left(stance_pitch, 1.0)) / duration,
             step_length=self.step_length,
         )

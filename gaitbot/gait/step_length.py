@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .blend import BoulicBlend
 from .boulic import REGION_A_MAX, TABLE2_CYCLE_S, pose_rad
 from .geometry import LegGeometry, foot_pitch, leg_points
 
@@ -38,16 +39,21 @@ def boulic_step_length(geometry: LegGeometry, rv, cycle_s: float = TABLE2_CYCLE_
     """Realised step length of the Boulic model at RV (array or scalar), in geometry units.
 
     At heel strike (phase 0) the left leg is in front at its phase 0, the right behind at 0.5.
+    Vectorised over RV (BoulicBlend's region-A form: one RV per sample at fixed phases).
     """
     rv = np.atleast_1d(np.asarray(rv, dtype=float))
-    out = np.empty_like(rv)
-    for i, r in enumerate(rv):  # keyframes differ per RV; each evaluation is a handful of flops
-        pose = pose_rad(float(r), 0.0, cycle_s)
-        _, _, heel_front, _ = leg_points(geometry, *pose[:3])
-        _, _, heel_rear, toe_rear = leg_points(geometry, *pose[3:])
-        anchor = rolling_anchor_x(geometry, heel_rear[0], toe_rear[0], foot_pitch(*pose[3:]))
-        out[i] = heel_front[0] - anchor
-    return out
+    blend = BoulicBlend([0.0, REGION_A_MAX], cycle_s)
+    if np.all(rv <= REGION_A_MAX):
+        u = rv / REGION_A_MAX  # degree-1 Bernstein weights (1 - u, u) give RV = u * 0.5 exactly
+        front = blend.leg(np.zeros_like(rv), u)
+        rear = blend.leg(np.full_like(rv, 0.5), u)
+    else:
+        front = np.array([pose_rad(float(r), 0.0, cycle_s)[:3] for r in rv])
+        rear = np.array([pose_rad(float(r), 0.0, cycle_s)[3:] for r in rv])
+    _, _, heel_front, _ = leg_points(geometry, *front.T)
+    _, _, heel_rear, toe_rear = leg_points(geometry, *rear.T)
+    anchor = rolling_anchor_x(geometry, heel_rear[:, 0], toe_rear[:, 0], foot_pitch(*rear.T))
+    return heel_front[:, 0] - anchor
 
 
 def step_length_to_rv_bisection(geometry: LegGeometry, step_length: float, tolerance: float = 0.01,
@@ -130,9 +136,47 @@ class StepLengthInverse:
         Step lengths below SL(RV=0) (possible only for legs where SL(0) > 0) map to RV = 0.
         """
         value = self.validate(step_length)
-        if value <= self.sl_grid[0]:
-            return 0.0 if self.sl_grid[0] >= 0.0 else self._solve(value)
-        return self._solve(value)
+        cache = self._cache
+        if value not in cache:
+            if len(cache) > 4096:
+                cache.clear()
+            cache[value] = 0.0 if value <= self.sl_grid[0] and self.sl_grid[0] >= 0.0 else self._solve(value)
+        return cache[value]
+
+    @property
+    def _cache(self) -> dict:
+        try:
+            return self.__dict__["_rv_cache"]
+        except KeyError:
+            self.__dict__["_rv_cache"] = {}
+            return self.__dict__["_rv_cache"]
+
+    def _step_length(self, rv: float) -> float:
+        """SL at one region-A RV in closed form: the heel-strike pose is affine in RV there."""
+        try:
+            front0, front1, rear0, rear1 = self.__dict__["_affine_pose"]
+        except KeyError:
+            ends = np.array([0.0, REGION_A_MAX])
+            blend = BoulicBlend(ends, self.cycle_s)
+            front = blend.leg(np.zeros(2), np.array([0.0, 1.0]))
+            rear = blend.leg(np.full(2, 0.5), np.array([0.0, 1.0]))
+            front0, front1 = front[0], (front[1] - front[0]) / REGION_A_MAX
+            rear0, rear1 = rear[0], (rear[1] - rear[0]) / REGION_A_MAX
+            self.__dict__["_affine_pose"] = (front0, front1, rear0, rear1)
+        g = self.geometry
+        hf, kf, af = front0 + front1 * rv
+        hr, kr, ar = rear0 + rear1 * rv
+        # heel of each foot relative to the hip: ankle, then ankle_height down the sole normal, heel_back along it
+        def heel_x(h, k, a):
+            pitch = h - k + a
+            ankle = g.thigh * math.sin(h) + g.shank * math.sin(h - k)
+            return ankle + g.ankle_height * math.sin(pitch) - g.heel_back * math.cos(pitch), pitch
+        front_heel, _ = heel_x(hf, kf, af)
+        rear_heel, rear_pitch = heel_x(hr, kr, ar)
+        if rear_pitch >= 0.0:
+            return front_heel - rear_heel
+        toe = rear_heel + g.foot * math.cos(rear_pitch)
+        return front_heel - (toe - g.foot)
 
     def _solve(self, target: float) -> float:
         i = int(np.clip(np.searchsorted(self.sl_grid, target) - 1, 0, len(self.rv_grid) - 2))
@@ -144,7 +188,7 @@ class StepLengthInverse:
             rv = lo_rv - lo_sl * (hi_rv - lo_rv) / (hi_sl - lo_sl) if hi_sl != lo_sl else 0.5 * (lo_rv + hi_rv)
             if not lo_rv < rv < hi_rv:
                 rv = 0.5 * (lo_rv + hi_rv)
-            err = float(boulic_step_length(self.geometry, rv, self.cycle_s)[0]) - target
+            err = self._step_length(rv) - target
             if abs(err) <= self.tolerance:
                 return rv
             if err < 0:

@@ -1,0 +1,80 @@
+"""``gaitbot plot``: a trajectory as one picture a person can read at a glance.
+
+Three panels sharing the time axis where it makes sense: joint angles against time (heel strikes
+marked), foot heights against time (lowest sole point of each foot, with the clearance line), and
+a stick-figure strip of the walk in the world with the footholds marked.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from gaitbot.gait.geometry import LegGeometry, leg_points
+from gaitbot.gait.trajectory import WALKING_JOINTS, Trajectory
+
+_COLOURS = {"left": "tab:blue", "right": "tab:red"}
+
+
+def _world_points(geometry: LegGeometry, trajectory: Trajectory, side: int):
+    q = trajectory.angles_rad[:, 3 * side:3 * side + 3]
+    knee, ankle, heel, toe = leg_points(geometry, q[:, 0], q[:, 1], q[:, 2])
+    root = trajectory.root_m
+    return root, knee + root, ankle + root, heel + root, toe + root
+
+
+def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, clearance: float = 0.0,
+                    title: str = "") -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = trajectory.t_s
+    fig = plt.figure(figsize=(12, 9), constrained_layout=True)
+    grid = fig.add_gridspec(3, 1, height_ratios=[1.2, 0.8, 1.0])
+    ax_angles, ax_feet, ax_stick = (fig.add_subplot(grid[i]) for i in range(3))
+
+    for i, name in enumerate(WALKING_JOINTS):
+        side = "left" if name.endswith("left") else "right"
+        style = {"hip": "-", "knee": "--", "ankle": ":"}[name.split("_")[0]]
+        ax_angles.plot(t, np.degrees(trajectory.angles_rad[:, i]), style, color=_COLOURS[side], lw=1.2,
+                       label=name.replace("_pitch", ""))
+    for strike in trajectory.heel_strikes:
+        ax_angles.axvline(strike.t_s, color=_COLOURS[strike.leg], lw=0.5, alpha=0.4)
+    ax_angles.set_ylabel("joint angle (deg, flexion +)")
+    ax_angles.legend(ncol=6, fontsize=8, loc="upper center")
+    ax_angles.set_title(f"{title}  {len(t)} frames, {t[-1]:.2f} s, {trajectory.root_m[-1, 0]:.3f} m"
+                        f"  (vertical lines: heel strikes)")
+    ax_angles.grid(alpha=0.3)
+
+    for side, name in ((0, "left"), (1, "right")):
+        _, _, _, heel, toe = _world_points(geometry, trajectory, side)
+        ax_feet.plot(t, 1000 * np.minimum(heel[:, 1], toe[:, 1]), color=_COLOURS[name], label=f"{name} foot lowest point")
+    if clearance > 0:
+        ax_feet.axhline(1000 * clearance, color="k", ls="--", lw=0.8, label=f"clearance {1000 * clearance:.0f} mm")
+    ax_feet.set_ylabel("foot height (mm)")
+    ax_feet.set_xlabel("time (s)")
+    ax_feet.legend(fontsize=8, loc="upper right")
+    ax_feet.grid(alpha=0.3)
+
+    strikes = [int(round(h.t_s / (t[1] - t[0]))) for h in trajectory.heel_strikes]
+    marks = [0, *strikes, len(t) - 1]
+    frames = sorted({*marks, *((a + b) // 2 for a, b in zip(marks, marks[1:]))})
+    for side, name in ((0, "left"), (1, "right")):
+        root, knee, ankle, heel, toe = _world_points(geometry, trajectory, side)
+        for k in frames:
+            xs = [root[k, 0], knee[k, 0], ankle[k, 0], heel[k, 0], toe[k, 0], ankle[k, 0]]
+            ys = [root[k, 1], knee[k, 1], ankle[k, 1], heel[k, 1], toe[k, 1], ankle[k, 1]]
+            ax_stick.plot(xs, ys, color=_COLOURS[name], lw=1.0, alpha=0.7)
+    ax_stick.plot(trajectory.root_m[:, 0], trajectory.root_m[:, 1], color="k", lw=0.8, label="hip path")
+    for strike in trajectory.heel_strikes:
+        ax_stick.plot([strike.x_m], [0.0], marker="^", color=_COLOURS[strike.leg], ms=8)
+    ax_stick.axhline(0.0, color="saddlebrown", lw=1.5)
+    ax_stick.set_aspect("equal")
+    ax_stick.set_xlabel("x (m)   poses at each heel strike and mid-step; triangles: planned footholds (blue left, red right)")
+    ax_stick.set_ylabel("y (m)")
+    ax_stick.legend(fontsize=8, loc="upper left")
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
