@@ -197,8 +197,12 @@ class Streamer:
         self.last_sent_ticks: np.ndarray | None = None
         self.previous_sent_ticks: np.ndarray | None = None
 
-    def run(self, frames: ArrayLike) -> StreamStats:
-        """Stream ``frames`` (N, len(ids)) of int ticks; return their timing."""
+    def run(self, frames: ArrayLike, start_s: float | None = None) -> StreamStats:
+        """Stream ``frames`` (N, len(ids)) of int ticks; return their timing.
+
+        ``start_s`` is the first frame's deadline (default: now); a session passes the deadline
+        after its previous run so consecutive runs keep one period apart on one absolute grid.
+        ``next_deadline_s`` holds the deadline after the last frame sent (also when interrupted)."""
         frames = _as_tick_frames(frames, len(self.ids))
         count = frames.shape[0]
         stats = StreamStats(period_s=self.period_s, late_threshold_s=self.late_threshold_s,
@@ -206,8 +210,9 @@ class Streamer:
         self.stats = stats
         clock, bus, ids, cpu = self.clock, self.bus, self.ids, self.cpu_time_s
         cpu_start = cpu()
-        start_s = clock.now()
+        start_s = clock.now() if start_s is None else start_s
         earliest_s = start_s
+        self.next_deadline_s = start_s
         try:
             for k in range(count):
                 deadline_s = start_s + k * self.period_s
@@ -219,6 +224,7 @@ class Streamer:
                 # time: converting a whole one-hour walk up front would take ~100 MB.
                 bus.write_goal_ticks(dict(zip(ids, frames[k].tolist())))
                 done_s = clock.now()
+                self.next_deadline_s = deadline_s + self.period_s
                 stats._record(send_s - deadline_s, done_s - send_s)
                 stats.wall_s = done_s - start_s
                 earliest_s = send_s + self.min_frame_interval_s
@@ -376,12 +382,19 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             state.opened = True  # close even if open fails halfway: a recording may already be started
             bus.open()
             present = prepare(bus, ids)
-            bus.write_goal_ticks(dict(zip(ids, present.tolist())))
-            state.last_sent = present
+            # Already at the first pose (within a tick): that pose is the goal written before torque on,
+            # and it counts as the walk's first frame, so a recording holds exactly the trajectory.
+            at_start = int(np.max(np.abs(present - walk[0]))) <= 1
+            first_goal = walk[0] if at_start else present
+            first_sent_s = clock.now()
+            bus.write_goal_ticks(dict(zip(ids, first_goal.tolist())))
+            state.last_sent = first_goal
             state.torque_on = True  # before the call: a torque-on that fails halfway still gets its torque-off
             bus.set_torque(ids, True)
-            state.run(streamer(), ramp(present, walk[0]))
-            state.run(streamer(on_frame), walk, is_walk=True)
+            state.next_deadline_s = first_sent_s + period_s
+            if not at_start:
+                state.run(streamer(), ramp(present, walk[0]))
+            state.run(streamer(on_frame), walk[1:] if at_start else walk, is_walk=True)
             state.run(streamer(), stop(walk[-2] if len(walk) > 1 else walk[-1], walk[-1]))
             outcome, error = "completed", None
         except (KeyboardInterrupt, Terminated) as exc:
@@ -418,11 +431,13 @@ class _SessionState:
         self.previous_sent: np.ndarray | None = None
         self.walk_stats: StreamStats | None = None
         self.notes: list[str] = []
+        self.next_deadline_s: float | None = None  # keeps consecutive runs on one frame grid
 
     def run(self, streamer: Streamer, frames: np.ndarray, is_walk: bool = False) -> None:
         try:
-            stats = streamer.run(frames)
+            stats = streamer.run(frames, self.next_deadline_s)
         finally:
+            self.next_deadline_s = getattr(streamer, "next_deadline_s", self.next_deadline_s)
             if streamer.last_sent_ticks is not None:
                 before = streamer.previous_sent_ticks
                 self.previous_sent = before if before is not None else self.last_sent
