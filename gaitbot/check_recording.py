@@ -1,0 +1,604 @@
+"""Limit checking of a recorded bus run (a ``gaitbot-bus-log`` JSON Lines file).
+
+A recording is checked in two layers:
+
+* **the bus**: every packet well formed (checksum/CRC, framing, hex), every goal frame addressing
+  exactly the configured ids, no unknown ids anywhere, and the regularity of the goal frames
+  (mean, p99 and worst gap against the configured rate);
+* **the joints**: the goal ticks decoded back to angles and put through the very same
+  ``check_trajectory`` as a trajectory file (position, tick range, wrap seam, velocity,
+  acceleration), at the recorded send times.
+
+Choices (also in ``docs/check.md``):
+
+* Robot: ``--robot`` if given; otherwise the header's ``robot`` name if a shipped config of that
+  name exists; otherwise exit 2 asking for ``--robot``. The config must match the recording (joint
+  names and ids, servo models, backend and protocol) or the file is rejected (exit 2): the checks
+  would be meaningless against another robot. A different baud rate or robot name is a warning.
+* Which goal writes count: ``walk_session`` writes the present pose as goal *before* torque on
+  (the servo is limp and already there), then streams the ramp, the walk and the stop. Frames
+  before the first torque-on write are checked for ids and packets but not for motion or timing;
+  everything from the first goal write after torque-on is the streamed series. A recording with no
+  torque-on write at all is taken as streamed from its first goal write.
+* Frame timing: the gap between consecutive streamed goal writes must not exceed
+  ``MAX_GAP_PERIODS`` (1.5) periods of ``gait.rate_hz`` -- a frame more than half a period late
+  left the servos without a new goal for that long. Time going backwards is an error too. Short
+  gaps are not errors: each phase (ramp, walk, stop) starts its own clock, so its first frame
+  follows the previous phase's last one almost at once.
+* Motion at the recorded times: a goal write at the same time as (or earlier than) the previous
+  one supersedes it for velocity and acceleration (a virtual-clock dry run logs phase boundaries at
+  one instant). A corrupted goal write is ignored by the servos, so it is left out of the motion
+  (but still counts as a frame for timing: the byte went out on time). A joint missing from a frame
+  keeps its previous goal, which is what the servo does.
+* Packets: a malformed packet, tx or rx, is an error (exit 1) naming line, time and bytes -- it is a
+  fault of the run, not an unreadable file. A status packet reporting a servo error is a warning.
+  An unparseable JSON line, a line without t/dir/hex, a missing header and a truncated last line
+  (no newline) are unreadable input (exit 2). ``allow_partial_last_line=True`` (``gaitbot check
+  --allow-partial``, ``tools/check_trajectory.py --allow-partial``) instead drops that one line with a
+  warning, for checking the recording of a crashed run.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from gaitbot.bus import wire
+from gaitbot.bus.log_decoder import LOG_FORMAT, LOG_VERSION, RecordedPacket, RecordingError, parse_packet
+from gaitbot.check import CheckReport, check_trajectory
+from gaitbot.robot.calibration import ticks_to_angles
+from gaitbot.robot.config import RobotConfig
+from gaitbot.robot.servo_models import servo_model
+
+MAX_GAP_PERIODS = 1.5
+BUS_KIND_ORDER = ("packet", "ids", "timing", "status", "file", "config")
+_HEADER_KEYS = ("backend", "protocol", "baudrate", "robot", "joints", "models")
+_HEX_SHOWN = 48  # hex characters of a packet quoted in a message
+
+
+class RecordingMismatch(RecordingError):
+    """The robot config does not describe the robot the recording was made with (exit 2)."""
+
+
+@dataclass(frozen=True)
+class BusIssue:
+    """A problem of the recorded bus traffic (not of a joint's motion).
+
+    kind: "packet" (malformed), "ids" (missing/unknown/repeated id), "timing" (late frame, time
+    backwards), "status" (a servo reported an error), "file" (partial last line), "config"
+    (recording and config differ in a detail that does not change the checks).
+    """
+
+    kind: str
+    severity: str  # "error" | "warning"
+    line_no: int
+    t_s: float
+    message: str
+    packet_hex: str = ""
+
+    def describe(self) -> str:
+        text = f"line {self.line_no}, t={self.t_s:.3f} s: {self.message}"
+        if self.packet_hex:
+            shown = self.packet_hex if len(self.packet_hex) <= _HEX_SHOWN else self.packet_hex[:_HEX_SHOWN] + "..."
+            text += f" [{shown}]"
+        return text
+
+
+@dataclass(frozen=True)
+class FrameTiming:
+    """Regularity of the streamed goal writes against the configured rate."""
+
+    rate_hz: float
+    period_s: float
+    n_frames: int
+    mean_gap_s: float
+    p99_gap_s: float
+    worst_gap_s: float
+    worst_gap_t_s: float  # time of the frame that ended the worst gap
+    worst_gap_line: int
+    max_gap_s: float  # the limit: MAX_GAP_PERIODS periods
+    n_late: int
+    n_backwards: int
+
+    def describe(self) -> str:
+        ms = 1000.0
+        if self.n_frames < 2:
+            return f"frame timing: {self.n_frames} streamed goal frame(s), no gaps to measure"
+        return (f"frame timing over {self.n_frames} streamed goal frames at {self.rate_hz:g} Hz "
+                f"(period {self.period_s * ms:.2f} ms): mean gap {self.mean_gap_s * ms:.2f} ms, "
+                f"p99 {self.p99_gap_s * ms:.2f} ms, worst {self.worst_gap_s * ms:.2f} ms "
+                f"({self.worst_gap_s / self.period_s:.2f} periods) at t={self.worst_gap_t_s:.3f} s "
+                f"(line {self.worst_gap_line}); limit {self.max_gap_s * ms:.2f} ms "
+                f"({MAX_GAP_PERIODS:g} periods): {self.n_late} late, {self.n_backwards} backwards")
+
+
+@dataclass(frozen=True)
+class RecordingReport:
+    """Result of ``check_recording``: bus issues, frame timing and the joint check of the goal frames."""
+
+    path: str
+    robot: str
+    backend: str
+    protocol: float
+    n_packets: int
+    n_tx: int
+    n_rx: int
+    n_goal_frames: int
+    timing: FrameTiming
+    issues: tuple[BusIssue, ...]
+    joints: CheckReport
+    sample_lines: tuple[int, ...]  # line of each motion sample, in order (for naming lines)
+    sample_t_s: tuple[float, ...]
+
+    @property
+    def errors(self) -> tuple[BusIssue, ...]:
+        return tuple(i for i in self.issues if i.severity == "error")
+
+    @property
+    def warnings(self) -> tuple[BusIssue, ...]:
+        return tuple(i for i in self.issues if i.severity == "warning")
+
+    @property
+    def ok(self) -> bool:
+        return not self.errors and self.joints.ok
+
+    @property
+    def first_error(self) -> str | None:
+        if self.errors:
+            return self.errors[0].describe()
+        return self.joints.first_error
+
+    def line_of(self, t_s: float) -> int | None:
+        """The recording line of the motion sample at ``t_s`` (None if there is none)."""
+        times = np.asarray(self.sample_t_s)
+        i = int(np.searchsorted(times, t_s))
+        for j in (i, i - 1):
+            if 0 <= j < len(times) and times[j] == t_s:
+                return self.sample_lines[j]
+        return None
+
+    def to_dict(self) -> dict:
+        joint_violations = self.joints.to_dict()
+        for v in joint_violations["violations"]:
+            v["line_no"] = self.line_of(v["t_s"])
+        n_errors = len(self.errors) + len(self.joints.errors)
+        n_warnings = len(self.warnings) + len(self.joints.warnings)
+        return {
+            "ok": self.ok,
+            "kind": "recording",
+            "file": self.path,
+            "robot": self.robot,
+            "backend": self.backend,
+            "protocol": self.protocol,
+            "n_packets": self.n_packets,
+            "n_tx": self.n_tx,
+            "n_rx": self.n_rx,
+            "n_goal_frames": self.n_goal_frames,
+            "n_errors": n_errors,
+            "n_warnings": n_warnings,
+            "first_error": self.first_error,
+            "frame_timing": asdict(self.timing),
+            "bus_issues": [{**asdict(i), "message_line": i.describe()} for i in self.issues],
+            "joint_check": joint_violations,
+        }
+
+    def format_text(self, max_per_kind: int = 5) -> str:
+        n_errors = len(self.errors) + len(self.joints.errors)
+        n_warnings = len(self.warnings) + len(self.joints.warnings)
+        lines = [f"{self.path}: recording of {self.robot} ({self.backend} protocol {self.protocol:g}): "
+                 f"{'OK' if self.ok else 'FAIL'} ({n_errors} errors, {n_warnings} warnings)",
+                 f"bus: {self.n_packets} packets ({self.n_tx} tx, {self.n_rx} rx), {self.n_goal_frames} goal frames; "
+                 f"{_count(self.issues, 'packet')} malformed, {_count(self.issues, 'ids')} id problems, "
+                 f"{_count(self.issues, 'timing')} timing problems",
+                 self.timing.describe(),
+                 "",
+                 "joint limits, goal ticks decoded to angles at the recorded send times:",
+                 self.joints.format_text(max_per_kind)]
+        lines = _with_lines(lines, self)
+        for kind in BUS_KIND_ORDER:
+            found = [i for i in self.issues if i.kind == kind]
+            if not found:
+                continue
+            lines += ["", f"{kind} ({len(found)}):"]
+            lines += [f"  {i.severity}: {i.describe()}" for i in found[:max_per_kind]]
+            if len(found) > max_per_kind:
+                lines.append(f"  ... and {len(found) - max_per_kind} more")
+        return "\n".join(lines)
+
+
+def _count(issues, kind: str) -> int:
+    return sum(1 for i in issues if i.kind == kind)
+
+
+def _with_lines(lines: list[str], report: RecordingReport) -> list[str]:
+    """Append the recording line to each joint violation printed by the trajectory report."""
+    by_message = {}
+    for v in report.joints.violations:
+        line = report.line_of(v.t_s)
+        if line is not None:
+            by_message[v.describe()] = line
+    text = "\n".join(lines)
+    out = []
+    for row in text.split("\n"):
+        stripped = row.strip()
+        for prefix in ("error: ", "warning: "):
+            if stripped.startswith(prefix) and stripped[len(prefix):] in by_message:
+                row += f" (line {by_message[stripped[len(prefix):]]})"
+                break
+        out.append(row)
+    return out
+
+
+# ---------------------------------------------------------------------------------------------- reading
+
+
+@dataclass(frozen=True)
+class _Logged:
+    """One packet line: parsed packet or, when its hex is not hex, the problem."""
+
+    line_no: int
+    t_s: float
+    direction: str
+    hex: str
+    parsed: object | None  # ParsedPacket
+    problem: str
+
+
+def read_log(path: str | Path, *, allow_partial_last_line: bool = False) -> tuple[dict, list[_Logged], list[BusIssue]]:
+    """Header, every packet line, and file-level warnings. Raises RecordingError (exit 2) for a file
+    that cannot be read as a bus log; bad bytes inside a packet are left for the checks."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise RecordingError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise RecordingError(f"{path}: cannot read ({exc})") from None
+    lines = text.split("\n")
+    notes: list[BusIssue] = []
+    if lines and lines[-1] == "":
+        lines.pop()
+    elif lines and lines[-1].strip():
+        n = len(lines)
+        if not allow_partial_last_line:
+            raise RecordingError(f"{path}:{n}: truncated last line (no newline: the file was cut short, "
+                                 "e.g. by a crash while writing); pass --allow-partial to check the complete lines")
+        notes.append(BusIssue("file", "warning", n, float("nan"),
+                              "truncated last line (no newline) ignored; checked the complete lines before it"))
+        lines.pop()
+    if not lines or not lines[0].strip():
+        raise RecordingError(f"{path}:1: empty file, no {LOG_FORMAT} header")
+    header = _header(path, lines[0])
+    framing = wire.framing_for(header["backend"], header["protocol"])
+    packets = [_packet(path, n, line, framing) for n, line in enumerate(lines[1:], start=2) if line.strip()]
+    if notes:
+        last_t = packets[-1].t_s if packets else 0.0
+        notes = [BusIssue(i.kind, i.severity, i.line_no, last_t, i.message) for i in notes]
+    return header, packets, notes
+
+
+def _header(path: Path, line: str) -> dict:
+    try:
+        header = json.loads(line)
+    except json.JSONDecodeError as exc:
+        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (line 1 is not JSON: {exc.msg})") from None
+    if not isinstance(header, dict) or header.get("format") != LOG_FORMAT:
+        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (the first line must be "
+                             f"{{\"format\": \"{LOG_FORMAT}\", ...}}; is the file a bus recording, complete from its start?)")
+    if header.get("version") != LOG_VERSION:
+        raise RecordingError(f"{path}:1: unsupported log version {header.get('version')!r} (reads {LOG_VERSION})")
+    missing = [k for k in _HEADER_KEYS if k not in header]
+    if missing:
+        raise RecordingError(f"{path}:1: header lacks {', '.join(missing)}")
+    joints, models = header["joints"], header["models"]
+    if not isinstance(joints, dict) or not isinstance(models, dict):
+        raise RecordingError(f"{path}:1: header joints and models must be objects")
+    try:
+        header["joints"] = {str(k): int(v) for k, v in joints.items()}
+        header["models"] = {int(k): str(v) for k, v in models.items()}
+        header["protocol"] = float(header["protocol"])
+        for name in header["models"].values():
+            servo_model(name)
+    except (TypeError, ValueError, KeyError) as exc:
+        raise RecordingError(f"{path}:1: bad header joints/models/protocol: {exc}") from None
+    if header["backend"] not in ("dynamixel", "feetech"):
+        raise RecordingError(f"{path}:1: unknown backend {header['backend']!r} (dynamixel or feetech)")
+    return header
+
+
+def _packet(path: Path, line_no: int, line: str, framing: str) -> _Logged:
+    try:
+        obj = json.loads(line)
+    except json.JSONDecodeError as exc:
+        raise RecordingError(f"{path}:{line_no}: bad JSON ({exc.msg}); not a bus recording line") from None
+    if not isinstance(obj, dict) or not all(k in obj for k in ("t", "dir", "hex")):
+        raise RecordingError(f"{path}:{line_no}: not a packet line (needs t, dir, hex)")
+    try:
+        t_s = float(obj["t"])
+    except (TypeError, ValueError):
+        raise RecordingError(f"{path}:{line_no}: t is not a number: {obj['t']!r}") from None
+    if not np.isfinite(t_s):
+        raise RecordingError(f"{path}:{line_no}: t is not a finite number: {obj['t']!r}")
+    direction, hex_text = obj["dir"], obj["hex"]
+    if direction not in ("tx", "rx"):
+        raise RecordingError(f"{path}:{line_no}: dir must be \"tx\" or \"rx\", got {direction!r}")
+    if not isinstance(hex_text, str):
+        raise RecordingError(f"{path}:{line_no}: hex must be a string")
+    try:
+        data = bytes.fromhex(hex_text)
+    except ValueError:
+        return _Logged(line_no, t_s, direction, hex_text, None, "bytes are not valid hex (corrupted line)")
+    parsed = parse_packet(RecordedPacket(line_no, t_s, direction, data), framing)
+    return _Logged(line_no, t_s, direction, hex_text, parsed, "" if parsed.checksum_ok else parsed.problem)
+
+
+# ---------------------------------------------------------------------------------------------- robot
+
+
+def robot_for_recording(path: str | Path, robot: str | None, load_robot) -> RobotConfig:
+    """The config to check ``path`` against: ``robot`` if given, else the shipped config named in the
+    header. ``load_robot`` is ``gaitbot.session.load_robot`` (passed in: the check room does not
+    import the command wiring)."""
+    if robot:
+        return load_robot(robot)
+    header = _header_only(path)
+    name = str(header.get("robot", ""))
+    from gaitbot.robot.config import shipped_config_dirs, shipped_config_names
+
+    if name in shipped_config_names():
+        for directory in shipped_config_dirs():
+            candidate = directory / f"{name}.toml"
+            if candidate.is_file():
+                return load_robot(str(candidate))
+    raise RecordingError(f"{path}: recorded with robot {name!r}, which is not a shipped config "
+                         f"({', '.join(shipped_config_names())}); give its config with --robot PATH")
+
+
+def _header_only(path: str | Path) -> dict:
+    path = Path(path)
+    try:
+        with open(path, encoding="utf-8") as f:
+            first = f.readline()
+    except FileNotFoundError:
+        raise RecordingError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise RecordingError(f"{path}: cannot read ({exc})") from None
+    if not first.strip():
+        raise RecordingError(f"{path}:1: empty file, no {LOG_FORMAT} header")
+    return _header(path, first)
+
+
+def match_config(path: str | Path, header: dict, config: RobotConfig) -> list[BusIssue]:
+    """Raise RecordingMismatch when ``config`` is not the robot of the recording; return warnings
+    for differences that do not change the checks."""
+    rec_joints = header["joints"]
+    cfg_joints = {j.name: j.id for j in config.joints}
+    where = f"{path}: recording does not match robot config {config.path}"
+    if rec_joints != cfg_joints:
+        only_rec = sorted(f"{n}={i}" for n, i in rec_joints.items() if cfg_joints.get(n) != i)
+        only_cfg = sorted(f"{n}={i}" for n, i in cfg_joints.items() if rec_joints.get(n) != i)
+        raise RecordingMismatch(f"{where}: joint ids differ (recording has {', '.join(only_rec) or 'nothing else'}; "
+                                f"config has {', '.join(only_cfg) or 'nothing else'}); pass the config it was recorded with "
+                                "via --robot")
+    cfg_models = {j.id: j.model.name for j in config.joints}
+    if header["models"] != cfg_models:
+        diff = sorted(f"id {i}: {header['models'].get(i)} vs {cfg_models.get(i)}"
+                      for i in set(cfg_models) | set(header["models"]) if header["models"].get(i) != cfg_models.get(i))
+        raise RecordingMismatch(f"{where}: servo models differ (recording vs config: {'; '.join(diff)})")
+    if (header["backend"], float(header["protocol"])) != (config.bus.backend, float(config.bus.protocol)):
+        raise RecordingMismatch(f"{where}: bus differs (recording {header['backend']} protocol {header['protocol']:g}, "
+                                f"config {config.bus.backend} protocol {config.bus.protocol:g})")
+    notes = []
+    if int(header["baudrate"]) != int(config.bus.baudrate):
+        notes.append(BusIssue("config", "warning", 1, 0.0, f"recorded at {header['baudrate']} baud, config says "
+                              f"{config.bus.baudrate}"))
+    if str(header["robot"]) != config.name:
+        notes.append(BusIssue("config", "warning", 1, 0.0, f"recorded as robot {header['robot']!r}, checked against "
+                              f"{config.name!r} (same joints, ids and servos)"))
+    return notes
+
+
+# ---------------------------------------------------------------------------------------------- checks
+
+
+def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0.0, *,
+                    allow_partial_last_line: bool = False) -> RecordingReport:
+    """Check a bus recording against ``config`` (see the module docstring for what and how).
+
+    Raises RecordingError (RecordingMismatch) for a file that cannot be checked: unreadable, no
+    header, a config of another robot, or no goal frames at all.
+    """
+    header, packets, issues = read_log(path, allow_partial_last_line=allow_partial_last_line)
+    issues += match_config(path, header, config)
+    names = {j.id: j.name for j in config.joints}
+    column = {j.id: c for c, j in enumerate(config.joints)}
+    known = set(column)
+    model = config.joints[0].model
+    goal_addr, goal_len = model.addr_goal_position, model.len_goal_position
+    torque_addr = model.addr_torque_enable
+    signed = goal_len == 4  # Dynamixel X goal position is a signed 32-bit register
+
+    timing_t, timing_line = [], []  # every streamed goal write (valid or not) after torque-on
+    frames_t, frames_line, frames_rows, frames_streamed = [], [], [], []
+    torque_seen = False
+    for p in packets:
+        if p.parsed is None or p.problem:
+            issues.append(BusIssue("packet", "error", p.line_no, p.t_s,
+                                   f"{p.direction} packet malformed: {p.problem}", p.hex))
+            if (p.direction == "tx" and torque_seen and p.parsed is not None
+                    and p.parsed.instruction == wire.INST_SYNC_WRITE):
+                timing_t.append(p.t_s)  # sent on time, ignored by the servos
+                timing_line.append(p.line_no)
+            continue
+        pk = p.parsed
+        if p.direction == "rx":
+            issues += _rx_issues(p, pk, known, names)
+            continue
+        is_goal = pk.instruction == wire.INST_SYNC_WRITE and (pk.address, pk.data_length) == (goal_addr, goal_len)
+        issues += _unknown_id_issues(p, pk, known, is_goal)
+        if is_goal:
+            row, frame_issues = _goal_row(p, pk, goal_len, config, column, names, signed)
+            issues += frame_issues
+            frames_t.append(p.t_s)
+            frames_line.append(p.line_no)
+            frames_rows.append(row)
+            frames_streamed.append(torque_seen)
+            if torque_seen:
+                timing_t.append(p.t_s)
+                timing_line.append(p.line_no)
+        elif _is_torque_on(pk, torque_addr):
+            torque_seen = True
+
+    if not frames_t:
+        raise RecordingError(f"{path}: no goal-position frames to check (sync writes to address {goal_addr}); "
+                             "was this recorded from a walk?")
+    streamed = np.array(frames_streamed, dtype=bool)
+    if not streamed.any():  # no torque-on write: the whole recording is the stream
+        streamed[:] = True
+        timing_t, timing_line = list(frames_t), list(frames_line)
+    timing, timing_issues = _frame_timing(config.gait.rate_hz, np.array(timing_t), np.array(timing_line, dtype=int))
+    issues += timing_issues
+
+    t_s, lines, ticks = _motion_samples(config, np.array(frames_t)[streamed], np.array(frames_line)[streamed],
+                                        np.array(frames_rows, dtype=float)[streamed])
+    angles_deg = np.degrees(ticks_to_angles(config, ticks))
+    joints = check_trajectory(config, t_s, angles_deg, margin_deg)
+    order = {k: i for i, k in enumerate(BUS_KIND_ORDER)}
+    issues.sort(key=lambda i: (order[i.kind], i.line_no))
+    return RecordingReport(path=str(path), robot=str(header["robot"]), backend=str(header["backend"]),
+                           protocol=float(header["protocol"]), n_packets=len(packets),
+                           n_tx=sum(1 for p in packets if p.direction == "tx"),
+                           n_rx=sum(1 for p in packets if p.direction == "rx"), n_goal_frames=len(frames_t),
+                           timing=timing, issues=tuple(issues), joints=joints,
+                           sample_lines=tuple(int(x) for x in lines), sample_t_s=tuple(float(x) for x in t_s))
+
+
+def _id_label(servo_id: int, names: dict[int, str]) -> str:
+    return f"id {servo_id} ({names[servo_id]})" if servo_id in names else f"id {servo_id}"
+
+
+def _rx_issues(p: _Logged, pk, known: set[int], names: dict[int, str]) -> list[BusIssue]:
+    out = []
+    if pk.packet_id not in known:
+        out.append(BusIssue("ids", "error", p.line_no, p.t_s,
+                            f"status packet from id {pk.packet_id}, which is not in the config", p.hex))
+    elif pk.error:
+        out.append(BusIssue("status", "warning", p.line_no, p.t_s,
+                            f"{_id_label(pk.packet_id, names)} reported error 0x{pk.error:02X}", p.hex))
+    return out
+
+
+def _unknown_id_issues(p: _Logged, pk, known: set[int], is_goal: bool) -> list[BusIssue]:
+    if pk.instruction in (wire.INST_SYNC_WRITE, wire.INST_SYNC_READ):
+        if pk.packet_id != wire.BROADCAST_ID:
+            return [BusIssue("ids", "error", p.line_no, p.t_s,
+                             f"sync packet sent to id {pk.packet_id}, not to broadcast {wire.BROADCAST_ID}", p.hex)]
+        if is_goal:
+            return []  # the goal frame check names its ids
+        unknown = [i for i in pk.ids if i not in known]
+    else:
+        unknown = [i for i in pk.ids if i not in known and i != wire.BROADCAST_ID]
+    if not unknown:
+        return []
+    return [BusIssue("ids", "error", p.line_no, p.t_s,
+                     f"tx packet addresses id {', '.join(map(str, unknown))}, not in the config", p.hex)]
+
+
+def _goal_row(p: _Logged, pk, goal_len: int, config: RobotConfig, column: dict[int, int],
+              names: dict[int, str], signed: bool) -> tuple[np.ndarray, list[BusIssue]]:
+    """Goal ticks of one frame in config joint order (NaN where a joint is not addressed) and its id issues."""
+    body = pk.data
+    row = np.full(len(config.joints), np.nan)
+    issues = []
+    stride = goal_len + 1
+    if len(body) % stride:
+        issues.append(BusIssue("packet", "error", p.line_no, p.t_s,
+                               f"goal frame payload of {len(body)} bytes is not a whole number of "
+                               f"{stride}-byte (id + goal) entries", p.hex))
+    order = config.joints[0].model.byte_order
+    ids_sent = []
+    for o in range(0, len(body) - goal_len, stride):
+        servo_id = body[o]
+        ids_sent.append(servo_id)
+        if servo_id in column:
+            row[column[servo_id]] = int.from_bytes(body[o + 1:o + 1 + goal_len], order, signed=signed)
+    unknown = sorted({i for i in ids_sent if i not in column})
+    repeated = sorted({i for i in ids_sent if ids_sent.count(i) > 1})
+    missing = [j.id for j in config.joints if j.id not in ids_sent]
+    if missing:
+        issues.append(BusIssue("ids", "error", p.line_no, p.t_s, "goal frame lacks "
+                               + ", ".join(_id_label(i, names) for i in missing), p.hex))
+    if unknown:
+        issues.append(BusIssue("ids", "error", p.line_no, p.t_s, "goal frame addresses unknown "
+                               + ", ".join(f"id {i}" for i in unknown) + " (not in the config)", p.hex))
+    if repeated:
+        issues.append(BusIssue("ids", "error", p.line_no, p.t_s, "goal frame repeats "
+                               + ", ".join(_id_label(i, names) for i in repeated), p.hex))
+    return row, issues
+
+
+def _is_torque_on(pk, torque_addr: int) -> bool:
+    if pk.address != torque_addr:
+        return False
+    if pk.instruction == wire.INST_WRITE:
+        return bool(pk.data[:1]) and pk.data[0] == 1
+    if pk.instruction == wire.INST_SYNC_WRITE:
+        return any(v[:1] == b"\x01" for v in pk.per_id_data.values())
+    return False
+
+
+def _frame_timing(rate_hz: float, t: np.ndarray, lines: np.ndarray) -> tuple[FrameTiming, list[BusIssue]]:
+    period = 1.0 / rate_hz
+    limit = MAX_GAP_PERIODS * period
+    gaps = np.diff(t)
+    issues = []
+    late = np.flatnonzero(gaps > limit + 1e-9)
+    back = np.flatnonzero(gaps < 0)
+    for k in late:
+        issues.append(BusIssue("timing", "error", int(lines[k + 1]), float(t[k + 1]),
+                               f"goal frame late: {gaps[k] * 1000:.2f} ms ({gaps[k] / period:.2f} periods) after the "
+                               f"previous one (line {lines[k]}, t={t[k]:.3f} s); limit {limit * 1000:.2f} ms "
+                               f"({MAX_GAP_PERIODS:g} periods at {rate_hz:g} Hz)"))
+    for k in back:
+        issues.append(BusIssue("timing", "error", int(lines[k + 1]), float(t[k + 1]),
+                               f"goal frame time goes backwards by {-gaps[k] * 1000:.2f} ms from the previous one "
+                               f"(line {lines[k]}, t={t[k]:.3f} s)"))
+    if len(gaps):
+        w = int(np.argmax(gaps))
+        timing = FrameTiming(rate_hz, period, len(t), float(gaps.mean()), float(np.percentile(gaps, 99)),
+                             float(gaps[w]), float(t[w + 1]), int(lines[w + 1]), limit, len(late), len(back))
+    else:
+        timing = FrameTiming(rate_hz, period, len(t), 0.0, 0.0, 0.0, float(t[0]) if len(t) else 0.0,
+                             int(lines[0]) if len(lines) else 0, limit, 0, 0)
+    return timing, issues
+
+
+def _motion_samples(config: RobotConfig, t: np.ndarray, lines: np.ndarray, rows: np.ndarray):
+    """(t_s, line, ticks) of the goal frames as the servos followed them: missing joints keep their
+    previous goal; a frame not later than the one before supersedes it (same time) or is dropped
+    (earlier: reported as a timing error)."""
+    rows = rows.copy()
+    for c in range(rows.shape[1]):
+        col = rows[:, c]
+        known = ~np.isnan(col)
+        if not known.any():
+            col[:] = config.joints[c].zero_tick
+            continue
+        idx = np.where(known, np.arange(len(col)), 0)
+        np.maximum.accumulate(idx, out=idx)
+        filled = col[idx]
+        first = int(np.argmax(known))
+        filled[:first] = col[first]
+        rows[:, c] = filled
+    # Keep the frames that set a new latest time; among equal times the last one wins.
+    running = np.maximum.accumulate(t)
+    new_time = t >= running  # not earlier than anything before
+    keep = new_time.copy()
+    keep_idx = np.flatnonzero(new_time)
+    if len(keep_idx) > 1:
+        same_as_next = t[keep_idx[:-1]] == t[keep_idx[1:]]
+        keep[keep_idx[:-1][same_as_next]] = False
+    return t[keep], lines[keep], rows[keep]
