@@ -58,8 +58,9 @@ def cmd_plot(args) -> int:
     return 0
 
 
-def _status_line(total: int, strikes, out=sys.stderr):
+def _status_line(total: int, strikes, rate_hz: float):
     """A cheap live status line: frame, step and late frames, rewritten in place on a terminal."""
+    out = sys.stderr
     if not out.isatty():
         return None
     times = [h.t_s for h in strikes]
@@ -67,7 +68,7 @@ def _status_line(total: int, strikes, out=sys.stderr):
     def on_frame(k: int, stats) -> None:
         if k % 6:
             return
-        step = sum(1 for t in times if t <= k / 60.0)
+        step = sum(1 for t in times if t <= k / rate_hz)
         out.write(f"\rframe {k + 1}/{total}  step {step}/{len(times)}  late {stats.late_frames}   ")
         out.flush()
 
@@ -100,7 +101,7 @@ def cmd_walk(args) -> int:
         result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
                               max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
                               torque_off_on_exit=config.bus.torque_off_on_exit,
-                              on_frame=_status_line(len(frames), walker.heel_strikes))
+                              on_frame=_status_line(len(frames), walker.heel_strikes, source.settings.rate_hz))
     finally:
         if recorder is not None:
             recorder.close()
