@@ -80,6 +80,7 @@ def main(argv: list[str] | None = None) -> int:
         else:
             parser.error(f"{args.command}: give --steps or --distance")
     from gaitbot import commands
+    from gaitbot.bus.base import BusError
     from gaitbot.errors import USER_ERRORS
 
     handler = getattr(commands, f"cmd_{args.command}")
@@ -90,6 +91,11 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"gaitbot {args.command}: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
+    except BusError as exc:  # a bus that fails outside a walk session (scan): one line, status 1
+        if args.debug:
+            raise
+        print(f"gaitbot {args.command}: bus error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 
+from gaitbot.bus.budget import check_rate
 from gaitbot.bus.factory import make_bus
 from gaitbot.bus.recording import BusRecorder
 from gaitbot.clock import MonotonicClock, VirtualClock
@@ -75,8 +77,28 @@ def _status_line(total: int, strikes, rate_hz: float):
     return on_frame
 
 
+def _require_port(port: str) -> None:
+    """A real run needs a serial device that exists: say which one is missing and how to list them."""
+    if not Path(port).exists():
+        raise UsageError(f"--port {port}: no such serial port (list them with: python -m serial.tools.list_ports -v; "
+                         f"or try --dry-run)")
+
+
+def _check_rate_override(config, rate) -> None:
+    if rate is None:
+        return
+    if not (math.isfinite(rate) and rate > 0):
+        raise UsageError(f"--rate must be a positive frame rate in Hz, got {rate!r}")
+    try:
+        check_rate(rate, config.bus.backend, config.bus.protocol, config.joints[0].model, len(config.joints),
+                   config.bus.baudrate, read_back=True)
+    except ValueError as exc:
+        raise UsageError(f"--rate {rate:g}: {exc}") from None
+
+
 def cmd_walk(args) -> int:
     config = load_robot(args.robot)
+    _check_rate_override(config, args.rate)
     args.robot = str(config.path)
     source, walker, trajectory = trajectory_for_robot(args)
     report = preflight(config, trajectory)
@@ -85,6 +107,8 @@ def cmd_walk(args) -> int:
     frames = angles_to_ticks(config, trajectory.angles_rad)
     period = 1.0 / source.settings.rate_hz
     port = args.port or config.bus.port
+    if not args.dry_run:
+        _require_port(port)
     clock = MonotonicClock() if (not args.dry_run or args.realtime) else VirtualClock()
     if not args.dry_run:
         warning = latency_timer_warning(port)
@@ -120,6 +144,8 @@ def cmd_walk(args) -> int:
 def cmd_scan(args) -> int:
     config = load_robot(args.robot)
     port = args.port or config.bus.port
+    if not args.dry_run:
+        _require_port(port)
     ids = range(0, 253) if args.all else config.ids
     names = {j.id: j.name for j in config.joints}
     bus = make_bus(config.bus.backend, config.bus.protocol, port, config.bus.baudrate, config.models_by_id,
