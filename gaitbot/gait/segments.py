@@ -151,6 +151,45 @@ def root_of(geometry: LegGeometry, anchor: float, foot_stance):
     return grounded_ankle(geometry, anchor, foot_stance[:, 2]) - foot_stance[:, :2]
 
 
+FLAT_FOOT_RAD = np.radians(3.0)  # width of the foot-flat pause where the stance sole crosses level
+
+
+def flat_pause(raw_pitch, width: float = FLAT_FOOT_RAD):
+    """Stance sole pitch from a raw pitch: p^3 / (p^2 + w^2).
+
+    A flat sole changes its pivot from heel to toe where its pitch crosses 0; crossing with a
+    non-zero pitch rate would jump the body's velocity by foot length x pitch rate. This map has
+    zero slope at 0 (a brief foot-flat pause, as a real foot has) and tends to p away from it."""
+    p = np.asarray(raw_pitch, dtype=float)
+    return p**3 / (p * p + width * width)
+
+
+def flat_pause_slope(raw_pitch, width: float = FLAT_FOOT_RAD):
+    p = np.asarray(raw_pitch, dtype=float)
+    return (p**4 + 3 * p * p * width * width) / (p * p + width * width) ** 2
+
+
+def flat_pause_inverse(pitch: float, width: float = FLAT_FOOT_RAD) -> float:
+    """The raw pitch whose flat_pause is ``pitch`` (Newton on the monotone cubic)."""
+    raw = float(pitch) + (width * width / pitch if abs(pitch) > width else 0.0)
+    if pitch == 0.0:
+        return 0.0
+    raw = raw if raw != 0.0 else pitch
+    for _ in range(60):
+        step = (float(flat_pause(raw, width)) - pitch) / max(float(flat_pause_slope(raw, width)), 1e-12)
+        raw -= step
+        if abs(step) < 1e-15:
+            break
+    return raw
+
+
+def _raw_pitch_state(pitch: float, rate: float) -> tuple[float, float]:
+    """Raw pitch and rate behind an actual stance pitch and rate (rate 0 at a flat foot)."""
+    raw = flat_pause_inverse(pitch)
+    slope = float(flat_pause_slope(raw))
+    return raw, (rate / slope if slope > 1e-9 else 0.0)
+
+
 def _lowering_needed(relative_xy, reach: float):
     """How much higher (relative to the hip) each foot point must be to lie within ``reach``."""
     x, y = relative_xy[:, 0], relative_xy[:, 1]
@@ -271,8 +310,11 @@ class StepSegment:
     # --- planning ---------------------------------------------------------------------------
     def _plan_landing_correction(self, duration: float) -> None:
         s = self.state
-        self._delta0 = s.foot_stance - self.model_stance(0.0)[0]
-        rate0 = s.foot_rate_stance * duration - _rate_right(self.model_stance, 0.0)
+        raw_pitch, raw_rate = _raw_pitch_state(s.foot_stance[2], s.foot_rate_stance[2])
+        start = np.array([*s.foot_stance[:2], raw_pitch])
+        start_rate = np.array([*s.foot_rate_stance[:2], raw_rate])
+        self._delta0 = start - self.model_stance(0.0)[0]
+        rate0 = start_rate * duration - _rate_right(self.model_stance, 0.0)
         self._delta_rate0 = rate0 * self.DECAY_U  # per unit of the decay window
 
     def _plan_rear_correction(self, duration: float) -> None:
@@ -287,7 +329,7 @@ class StepSegment:
         self.landing_pitch = max(float(front_end[2]), 0.0)  # heel first or flat, never toe first
         self.landing_ankle = heel_pinned_ankle(g, self.foothold, self.landing_pitch)
         self.root_at_strike = self.landing_ankle - front_end[:2]
-        ankle = grounded_ankle(g, self.state.anchor_stance, stance_end[2])
+        ankle = grounded_ankle(g, self.state.anchor_stance, flat_pause(stance_end[2]))
         self._gamma1 = np.array([*(ankle - self.root_at_strike - stance_end[:2]), 0.0])
 
     def _plan_reach(self) -> None:
@@ -314,6 +356,7 @@ class StepSegment:
         lower = smoothstep((u - self.LOWER_FROM_U) / (1.0 - self.LOWER_FROM_U))[:, None] * self._gamma1
         foot = self.model_stance(u) + delta + lower
         foot[:, 1] += self._reach_lowering * np.sin(np.pi * u) ** 2
+        foot[:, 2] = flat_pause(foot[:, 2])
         return foot
 
     def root(self, u):
@@ -345,6 +388,8 @@ class StepSegment:
         start = self._pinned_relative(u0)[0]
         start_rate = _rate_left(self._pinned_relative, u0)
         pitch_rate_end = _rate_left(lambda u: self.model_other(u)[:, 2], 1.0)
+        if self.landing_pitch <= 0.0:
+            pitch_rate_end = 0.0  # a flat landing pauses flat (see flat_pause)
         end = np.array([*(self.landing_ankle - self.root_at_strike), self.landing_pitch])
         heel_fixed = lambda p: heel_pinned_ankle(g, self.foothold, p)  # noqa: E731
         ankle_rate_end = (heel_fixed(self.landing_pitch + _H) - heel_fixed(self.landing_pitch - _H)) / (2 * _H)
@@ -371,13 +416,16 @@ class StepSegment:
         aim = np.where(inside, self.ctx.clearance * 1.02 + 1e-6 * g.leg_length, 1e-7 * g.leg_length)
         shape = plateau(s, CLEARANCE_WINDOW[0])
         usable = shape > 1e-6
-        for _ in range(8):  # the reach saturation makes height slightly non-linear in the lift
+        for _ in range(60):  # the reach saturation absorbs part of each lift increment: iterate to the end
             target = self.swing_relative(u)
             deficit = aim - lowest_sole_y(g, target[:, :2] + root, target[:, 2])
             extra = float((deficit[usable] / shape[usable]).max())
             if extra <= 1e-9 * g.leg_length:
                 break
-            self.lift += extra
+            self.lift += 1.5 * extra  # over-relaxed: near full reach only about 2/3 of a lift turns into height
+        else:
+            raise GaitGenerationError(f"{self.what}: the swing foot cannot clear the ground by "
+                                      f"{self.ctx.clearance:g} within the leg's reach")
 
     LEVEL_FROM_S, LEVEL_UNTIL_S = 0.3, 0.7  # the swing sole is level over this share of the swing
 
