@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from gaitbot.bus.base import Bus, BusError
+from gaitbot.bus.base import Bus, BusError, PortError, ServoTimeout
 from gaitbot.clock import Clock, MonotonicClock, VirtualClock
 from gaitbot.ramp import brake_ticks, ramp_ticks, stop_ticks
 
@@ -169,6 +169,10 @@ class Streamer:
     on_frame(k, stats) is called after frame k went out, in the loop's own time: keep it
     to reading the cheap fields of :class:`StreamStats` and printing now and then.
 
+    monitor() is called right after each write, inside the frame's bus time (``bus_call_s``
+    covers both): walk_session reads the servos back there, so that a servo that stops
+    answering or reports a fault ends the walk within a frame or two. It raises to stop.
+
     After ``run`` returns or raises, ``stats`` holds the figures so far,
     ``last_sent_ticks`` the last frame whose write was started (None before the first) and
     ``previous_sent_ticks`` the one before it (the safe stop's velocity estimate).
@@ -180,7 +184,8 @@ class Streamer:
                  on_frame: Callable[[int, StreamStats], None] | None = None, *,
                  late_threshold_s: float = LATE_THRESHOLD_S,
                  min_frame_interval_s: float | None = None,
-                 cpu_time_s: Callable[[], float] = time.process_time) -> None:
+                 cpu_time_s: Callable[[], float] = time.process_time,
+                 monitor: Callable[[], None] | None = None) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be > 0, got {period_s}")
         self.bus = bus
@@ -193,6 +198,7 @@ class Streamer:
         self.late_threshold_s = late_threshold_s
         self.min_frame_interval_s = 0.9 * self.period_s if min_frame_interval_s is None else min_frame_interval_s
         self.cpu_time_s = cpu_time_s
+        self.monitor = monitor
         self.stats = StreamStats(period_s=self.period_s, late_threshold_s=late_threshold_s)
         self.last_sent_ticks: np.ndarray | None = None
         self.previous_sent_ticks: np.ndarray | None = None
@@ -208,7 +214,7 @@ class Streamer:
         stats = StreamStats(period_s=self.period_s, late_threshold_s=self.late_threshold_s,
                             lateness_s=np.zeros(count), bus_call_s=np.zeros(count))
         self.stats = stats
-        clock, bus, ids, cpu = self.clock, self.bus, self.ids, self.cpu_time_s
+        clock, bus, ids, cpu, monitor = self.clock, self.bus, self.ids, self.cpu_time_s, self.monitor
         cpu_start = cpu()
         start_s = clock.now() if start_s is None else start_s
         earliest_s = start_s
@@ -223,6 +229,8 @@ class Streamer:
                 # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
                 # time: converting a whole one-hour walk up front would take ~100 MB.
                 bus.write_goal_ticks(dict(zip(ids, frames[k].tolist())))
+                if monitor is not None:
+                    monitor()
                 done_s = clock.now()
                 self.next_deadline_s = deadline_s + self.period_s
                 stats._record(send_s - deadline_s, done_s - send_s)
@@ -329,7 +337,7 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
                  period_s: float = 1 / 60, clock: Clock | None = None,
                  torque_off_on_exit: bool = False,
                  on_frame: Callable[[int, StreamStats], None] | None = None,
-                 handle_sigterm: bool = True) -> SessionResult:
+                 handle_sigterm: bool = True, monitor_servos: bool = True) -> SessionResult:
     """Open, check, ramp to the first pose, walk, and leave the robot in a known pose.
 
     Sequence: ``bus.open()`` -> :func:`prepare` (ping all, read present) -> write present
@@ -345,6 +353,17 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
         Ctrl-C or SIGTERM during it abandons it.
       * bus_error (1): one attempt at the ramp to stand. The first failing bus call ends it,
         so a dead bus costs one bounded timeout, never a hang. The error is in ``error``.
+        When the error is a :class:`~gaitbot.bus.base.PortError` (the port itself is gone),
+        nothing can reach the servos: no stop ramp and no torque-off are tried, the servos hold
+        their last goal, and a note says so.
+
+    Servo faults during motion: with ``monitor_servos`` (the default) every frame of the start
+    ramp, the walk and the final ramp is followed by a read-back of all servos
+    (``bus.read_present_ticks``), so that a servo that stops answering, answers late, sends
+    damaged packets or reports error bits (overload, overheating, input voltage) raises a
+    BusError naming it within that frame. The bus retries reads as its fault policy says
+    (see :class:`gaitbot.bus.sdk_bus.SdkBus`). The safe stop ramp is not read back: it must
+    reach the healthy servos whatever the faulty one does.
     In every case, torque goes off if ``torque_off_on_exit``, and the bus is closed in a
     ``finally`` so that a recording made by the bus is flushed and readable. Other
     exceptions (bugs) get the same safe stop and are then re-raised.
@@ -372,8 +391,15 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
         return stop_ticks(previous_ticks, last_ticks, stand, max_velocity_ticks_per_s, max_accel_ticks_per_s2,
                           period_s)
 
-    def streamer(callback=None) -> Streamer:
-        return Streamer(bus, ids, period_s, clock, callback)
+    def check_servos() -> None:
+        present = bus.read_present_ticks(ids)
+        silent = [i for i in ids if i not in present]
+        if silent:
+            raise ServoTimeout(f"servo {silent[0]} stopped answering reads during the walk", servo_id=silent[0])
+
+    def streamer(callback=None, monitored: bool = False) -> Streamer:
+        monitor = check_servos if (monitored and monitor_servos) else None
+        return Streamer(bus, ids, period_s, clock, callback, monitor=monitor)
 
     old_handler = _install_sigterm_handler() if handle_sigterm else None
     state = _SessionState()
@@ -402,7 +428,12 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             state.safe_stop(streamer, stop)
         except BusError as exc:
             outcome, error = "bus_error", exc
-            state.safe_stop(streamer, stop)
+            if isinstance(exc, PortError) and state.torque_on:
+                state.port_lost = True
+                state.notes.append("the port is gone, so no stop ramp or torque-off could be sent: "
+                                   "the servos hold their last goal")
+            else:
+                state.safe_stop(streamer, stop)
         except Exception:
             state.safe_stop(streamer, stop)
             state.finish(bus, ids, torque_off_on_exit)
@@ -425,6 +456,7 @@ class _SessionState:
 
     def __init__(self) -> None:
         self.opened = False
+        self.port_lost = False
         self.torque_on = False
         self.torque_off = False
         self.last_sent: np.ndarray | None = None
@@ -462,7 +494,7 @@ class _SessionState:
             self.notes.append(f"stop ramp abandoned: {exc}")
 
     def finish(self, bus: Bus, ids: list[int], torque_off_on_exit: bool) -> None:
-        if not (torque_off_on_exit and self.torque_on):
+        if not (torque_off_on_exit and self.torque_on) or self.port_lost:
             return
         try:
             bus.set_torque(ids, False)

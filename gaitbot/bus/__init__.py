@@ -3,7 +3,9 @@
     make_bus(backend, protocol, port, baudrate, models, dry_run, recorder=None) -> Bus
 """
 
-from gaitbot.bus.base import Bus, BusError, PortError, ServoStatusError, ServoTimeout
+from gaitbot.bus.base import (Bus, BusError, CorruptReplies, PortError, ServoLate, ServoStatusError,
+                              ServoTimeout)
 from gaitbot.bus.factory import make_bus, make_mock_bus
 
-__all__ = ["Bus", "BusError", "PortError", "ServoStatusError", "ServoTimeout", "make_bus", "make_mock_bus"]
+__all__ = ["Bus", "BusError", "CorruptReplies", "PortError", "ServoLate", "ServoStatusError", "ServoTimeout",
+           "make_bus", "make_mock_bus"]

@@ -33,8 +33,24 @@ class ServoTimeout(BusError):
     """A servo did not answer (after the bounded retries)."""
 
 
+class ServoLate(ServoTimeout):
+    """A servo's status packet arrived after the reply timeout: its answers can no longer be told
+    apart from answers to later questions, so the bus stops trusting them."""
+
+
+class CorruptReplies(ServoTimeout):
+    """Every attempt got a damaged status packet (bad checksum/CRC or truncated) from the servo."""
+
+
 class ServoStatusError(BusError):
-    """A servo answered with error bits set (overload, overheating, input voltage ...)."""
+    """A servo answered with error bits set (overload, overheating, input voltage ...).
+
+    ``fault``: the error in words (gaitbot.bus.status.describe_status_error).
+    """
+
+    def __init__(self, message: str, *, fault: str = "", **kwargs) -> None:
+        super().__init__(message, **kwargs)
+        self.fault = fault
 
 
 class Bus(ABC):

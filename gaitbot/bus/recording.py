@@ -119,9 +119,11 @@ class RecordingPort:
             self._inner.ser.reset_input_buffer()
 
     def closePort(self) -> None:  # noqa: N802
-        self._flush_rx(partial=True)
-        self._inner.closePort()
-        self._recorder.close()
+        try:
+            self._flush_rx(partial=True)
+            self._inner.closePort()
+        finally:  # a port that is already gone must not leave the recording unflushed
+            self._recorder.close()
 
     def _flush_rx(self, partial: bool) -> None:
         for chunk, _is_packet in wire.split_complete(self._rx_pending, self._framing):

@@ -6,24 +6,77 @@ handler and its quirks.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+import os
+import time
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
 from types import ModuleType
 from typing import Any
 
-from gaitbot.bus.base import Bus, BusError, PortError, ServoStatusError, ServoTimeout
+from gaitbot.bus import wire
+from gaitbot.bus.base import Bus, BusError, CorruptReplies, PortError, ServoLate, ServoStatusError, ServoTimeout
+from gaitbot.bus.status import HARDWARE_ERROR_STATUS, V2_ALERT, describe_status_error
 from gaitbot.robot.servo_models import ServoModel
 
+try:  # pyserial raises termios.error (not an OSError) from tcflush on a hung-up terminal
+    import termios
+    PORT_EXCEPTIONS: tuple[type[BaseException], ...] = (OSError, termios.error)
+except ImportError:  # pragma: no cover - not POSIX
+    PORT_EXCEPTIONS = (OSError,)
+
 LIST_PORTS_HINT = "list serial ports with: python -m serial.tools.list_ports -v"
+
+#: pyserial blocks forever in write() when nobody drains the line (a stuck adapter, a pty whose
+#: other end stopped reading). A 60 Hz frame is at most a few hundred bytes, so half a second
+#: is only ever reached when the port is dead.
+WRITE_TIMEOUT_S = 0.5
+#: After a status packet did not come within the SDK's reply timeout, listen this long for it.
+#: A reply arriving now was late, not lost: the servo (or the adapter) is too slow, and its next
+#: answers would be taken for answers to later questions, so the bus stops (ServoLate).
+LATE_REPLY_WATCH_MS = 40.0
+#: Linux pseudo-terminal slaves (Unix98 ptys) have device majors 136..143.
+_PTY_MAJORS = range(136, 144)
+
+
+def is_pseudo_terminal(port_name: str) -> bool:
+    """True for a pty slave such as /dev/pts/3 (the servo emulator's end): baud rates mean nothing there."""
+    try:
+        return os.major(os.stat(port_name).st_rdev) in _PTY_MAJORS
+    except (OSError, ValueError):
+        return False
 
 
 class SdkBus(Bus):
     """A servo chain driven through a vendor SDK's packet handler.
 
     ``port_handler`` replaces the SDK's ``PortHandler(port_name)`` (the mock and the recorder plug in
-    here), so dry runs send exactly the bytes a real run sends. Reads are retried ``retries`` more
-    times after the first attempt, because one lost status packet must not end a walk. Writes are
-    never retried: a goal sync write has no status packet to tell success from loss, and the next
-    frame supersedes it anyway.
+    here), so dry runs send exactly the bytes a real run sends.
+
+    Fault policy (what each failure costs and what it raises):
+
+    * Reads (present position, sync read or one by one) are retried ``retries`` more times after
+      the first attempt (default 3, so 4 attempts), because one lost or damaged status packet
+      must not end a walk. Each attempt waits at most the SDK's reply timeout (2 x 16 ms USB
+      latency + 2 ms + the packet's bytes at the baud rate: about 34 ms at 1 Mbaud, 50 ms for a
+      6-servo sync read at 57,600 baud). After an attempt in which a servo stayed silent the bus
+      listens ``LATE_REPLY_WATCH_MS`` more for that servo's status packet. All attempts failing
+      raises ``ServoTimeout`` (silent), or ``CorruptReplies`` (every reply had a bad checksum/CRC),
+      naming the servo.
+    * A reply that arrives after its timeout raises ``ServoLate`` at once, without retrying: late
+      answers cannot be matched to questions any more.
+    * A status packet with error bits (overload, overheating, input voltage, ...) raises
+      ``ServoStatusError`` at once, naming the servo and the fault in words. On Dynamixel 2.0 the
+      Hardware Error Status register is read once to say which hardware error the Alert bit means.
+      When torque is being switched off, error bits are recorded but not raised (the servo did
+      take the write).
+    * Any OS-level failure of the port (the adapter unplugged, the pty closed) raises
+      ``PortError`` at once; nothing is retried on a dead port. Writes time out after
+      ``WRITE_TIMEOUT_S`` instead of blocking.
+    * Goal writes are never retried: a goal sync write has no status packet to tell success from
+      loss, and the next frame supersedes it anyway.
+
+    So a read costs at most ``(1 + retries) x (reply timeout + LATE_REPLY_WATCH_MS)`` per servo
+    read on its own (sync reads: per call), about 0.3 s at 1 Mbaud with the defaults.
     """
 
     family = ""  # "dynamixel" or "feetech", set by subclasses
@@ -49,6 +102,8 @@ class SdkBus(Bus):
         self.port = port_handler if port_handler is not None else self.sdk.PortHandler(port_name)
         self._ph: Any = None
         self._is_open = False
+        self._timed_out_ids: set[int] = set()  # servos whose last attempt timed out (late-reply evidence)
+        self.open_notes: list[str] = []  # how the port was opened, when that differs from the config
 
     # --- hooks for subclasses -------------------------------------------------------------
     def _make_packet_handler(self) -> Any:
@@ -83,25 +138,74 @@ class SdkBus(Bus):
     def open(self) -> None:
         self._ph = self._make_packet_handler()
         try:
-            opened = self.port.openPort() and self.port.setBaudRate(self.baudrate)
-        except OSError as exc:  # serial.SerialException is an OSError
+            opened = self.port.openPort() and self._set_baud_rate()
+        except PORT_EXCEPTIONS as exc:  # serial.SerialException is an OSError
             raise PortError(f"cannot open serial port {self.port_name}: {exc}; {LIST_PORTS_HINT}") from exc
         if not opened:
             raise PortError(f"cannot open serial port {self.port_name} at {self.baudrate} baud (the SDK "
                             f"refused the port or the baud rate); {LIST_PORTS_HINT}")
         self._is_open = True
+        self._bound_write_time()
+
+    def _set_baud_rate(self) -> bool:
+        """The SDK's setBaudRate; on a pseudo-terminal, where the rate means nothing, a rate the SDK or
+        the kernel refuses is not an error: the port stays at a standard rate and the SDK's timeouts
+        are still computed from the configured one."""
+        try:
+            if self.port.setBaudRate(self.baudrate):
+                return True
+            refusal: BaseException | None = None
+        except PORT_EXCEPTIONS as exc:
+            refusal = exc
+        if not is_pseudo_terminal(self.port_name):
+            if refusal is not None:
+                raise refusal
+            return False
+        if not getattr(self.port, "is_open", False) and not self.port.setBaudRate(1_000_000):
+            return False
+        if hasattr(self.port, "tx_time_per_byte"):
+            self.port.tx_time_per_byte = (1000.0 / self.baudrate) * 10.0  # ms per byte, as the SDK computes it
+        self.port.baudrate = self.baudrate
+        self.open_notes.append(f"{self.port_name} is a pseudo-terminal: {self.baudrate} baud not set on it "
+                               "(rates mean nothing on a pty); timeouts still follow that rate")
+        return True
+
+    def _bound_write_time(self) -> None:
+        serial_port = getattr(self.port, "ser", None)
+        if serial_port is not None and getattr(serial_port, "write_timeout", 0) is None:
+            try:
+                serial_port.write_timeout = WRITE_TIMEOUT_S
+            except PORT_EXCEPTIONS:
+                pass
 
     def close(self) -> None:
         if self._is_open:
             self._is_open = False
-            self.port.closePort()
+            try:
+                self.port.closePort()
+            except PORT_EXCEPTIONS:
+                pass  # the port is already gone; closing it has nothing left to do
+
+    @contextmanager
+    def _port_guard(self, servo_id: int | None = None) -> Iterator[None]:
+        """Turn an OS-level failure of the port inside the SDK into PortError (never retried)."""
+        try:
+            yield
+        except PORT_EXCEPTIONS as exc:
+            try:
+                self.port.is_using = False  # the SDK's lock, left taken by the exchange that failed
+            except AttributeError:
+                pass
+            raise PortError(f"serial port {self.port_name} failed: {exc} (the adapter was unplugged or the "
+                            "port closed); the servos keep their last goal", servo_id=servo_id) from exc
 
     def ping(self, servo_id: int) -> bool:
         self._require_open()
         for _ in range(1 + self.retries):
             self._before_transaction()
-            self._drop_stale_input()
-            _model_number, result, error = self._ph.ping(self.port, servo_id)
+            with self._port_guard(servo_id):
+                self._drop_stale_input()
+                _model_number, result, error = self._ph.ping(self.port, servo_id)
             self._raise_on_port_failure(result, servo_id)
             if result == self.sdk.COMM_SUCCESS:
                 self.last_status_errors[servo_id] = error
@@ -112,14 +216,16 @@ class SdkBus(Bus):
         """Write Torque Enable to each servo and wait for its status packet.
 
         Disabling goes through every servo before raising, so one silent servo does not leave the
-        others powered.
+        others powered; a servo that confirms the write with error bits set has taken it, so those
+        bits are recorded in ``last_status_errors`` and not raised when disabling.
         """
         self._require_open()
         failures: list[BusError] = []
         for servo_id in ids:
             self._model(servo_id)
             try:
-                self._write_byte_confirmed(servo_id, self._torque_addr, 1 if enabled else 0)
+                self._write_byte_confirmed(servo_id, self._torque_addr, 1 if enabled else 0,
+                                           raise_status=enabled)
             except BusError as exc:
                 if enabled:
                     raise
@@ -141,7 +247,8 @@ class SdkBus(Bus):
         if not goals:
             return
         self._before_transaction()
-        result = group.txPacket()
+        with self._port_guard():
+            result = group.txPacket()
         self._raise_on_port_failure(result, None)
         if result != self.sdk.COMM_SUCCESS:
             raise BusError(f"goal sync write on {self.port_name} failed: {self._ph.getTxRxResult(result)}",
@@ -162,50 +269,145 @@ class SdkBus(Bus):
 
     # --- internals ------------------------------------------------------------------------
     def _sync_read(self, wanted: list[int]) -> dict[int, int]:
+        """GroupSyncRead's exchange, but keeping each status packet's error byte (GroupSyncRead drops it)."""
         address, length = self._present
         got: dict[int, int] = {}
         pending = list(wanted)
-        result = self.sdk.COMM_SUCCESS
+        failed_id, result = pending[0], self.sdk.COMM_SUCCESS
+        outcomes: dict[int, list[int]] = {}
         for _ in range(1 + self.retries):
             self._before_transaction()
-            self._drop_stale_input()
             group = self.sdk.GroupSyncRead(self.port, self._ph, address, length)
             for servo_id in pending:
                 group.addParam(servo_id)
-            result = group.txRxPacket()
+            with self._port_guard():
+                self._drop_stale_input()
+                result = group.txPacket()
             self._raise_on_port_failure(result, None)
+            if result != self.sdk.COMM_SUCCESS:
+                raise BusError(f"sync read on {self.port_name} failed: {self._ph.getTxRxResult(result)}",
+                               result_code=result)
             for servo_id in pending:
-                data = group.data_dict.get(servo_id) or []
-                if len(data) >= length:
-                    got[servo_id] = self._decode(bytes(data[:length]), self._model(servo_id))
+                with self._port_guard(servo_id):
+                    data, result, error = self._ph.readRx(self.port, servo_id, length)
+                if result != self.sdk.COMM_SUCCESS or len(data) < length:
+                    failed_id = servo_id
+                    break  # the SDK's timeout covered the whole sync read; ask the rest again
+                self._answered(servo_id, error)
+                got[servo_id] = self._decode(bytes(data[:length]), self._model(servo_id))
             pending = [i for i in pending if i not in got]
             if not pending:
                 return got
-        raise ServoTimeout(f"servo {pending[0]} on {self.port_name} did not return its present position "
-                           f"after {1 + self.retries} sync reads ({self._ph.getTxRxResult(result)})",
-                           result_code=result, servo_id=pending[0])
+            self._failed_attempt(failed_id, result, outcomes)
+        raise self._no_answer(failed_id, outcomes[failed_id], "sync reads")
 
     def _read_one(self, servo_id: int) -> int:
         address, length = self._present
-        result = self.sdk.COMM_SUCCESS
+        outcomes: dict[int, list[int]] = {}
         for _ in range(1 + self.retries):
             self._before_transaction()
-            self._drop_stale_input()
-            data, result, error = self._ph.readTxRx(self.port, servo_id, address, length)
+            with self._port_guard(servo_id):
+                self._drop_stale_input()
+                data, result, error = self._ph.readTxRx(self.port, servo_id, address, length)
             self._raise_on_port_failure(result, servo_id)
             if result == self.sdk.COMM_SUCCESS and len(data) >= length:
-                self.last_status_errors[servo_id] = error
+                self._answered(servo_id, error)
                 return self._decode(bytes(data[:length]), self._model(servo_id))
-        raise ServoTimeout(f"servo {servo_id} on {self.port_name} did not return its present position after "
-                           f"{1 + self.retries} reads ({self._ph.getTxRxResult(result)})",
-                           result_code=result, servo_id=servo_id)
+            self._failed_attempt(servo_id, result, outcomes)
+        raise self._no_answer(servo_id, outcomes[servo_id], "reads")
 
-    def _write_byte_confirmed(self, servo_id: int, address: int, value: int) -> None:
+    def _answered(self, servo_id: int, error: int) -> None:
+        """A good status packet: remember its error byte and raise ServoStatusError if bits are set."""
+        self._timed_out_ids.discard(servo_id)
+        self.last_status_errors[servo_id] = error
+        if error:
+            raise self._status_error(servo_id, error)
+
+    def _status_error(self, servo_id: int, error: int) -> ServoStatusError:
+        model = self._model(servo_id)
+        hardware = None
+        if self.family == "dynamixel" and self.protocol == 2.0 and error & V2_ALERT \
+                and model.name in HARDWARE_ERROR_STATUS:
+            try:  # one attempt: the message is better with it, the stop does not depend on it
+                with self._port_guard(servo_id):
+                    self._drop_stale_input()
+                    value, result, _ = self._ph.read1ByteTxRx(self.port, servo_id,
+                                                              HARDWARE_ERROR_STATUS[model.name][0])
+                hardware = value if result == self.sdk.COMM_SUCCESS else None
+            except BusError:
+                hardware = None
+        fault = describe_status_error(self.family, self.protocol, error, hardware, model.name)
+        detail = f"status error 0x{error:02X}" + (f", hardware error status 0x{hardware:02X}" if hardware else "")
+        return ServoStatusError(f"servo {servo_id} on {self.port_name} reports {fault} ({detail})",
+                                servo_id=servo_id, status_error=error, fault=fault)
+
+    def _failed_attempt(self, servo_id: int, result: int, outcomes: dict[int, list[int]]) -> None:
+        """Note one failed attempt; after a silent one, listen for the servo's late status packet."""
+        self._raise_on_port_failure(result, servo_id)
+        outcomes.setdefault(servo_id, []).append(result)
+        if result == self.sdk.COMM_RX_TIMEOUT:
+            self._timed_out_ids.add(servo_id)
+            self._watch_for_late_reply(servo_id)
+
+    def _no_answer(self, servo_id: int, results: list[int], what: str) -> ServoTimeout:
+        attempts = len(results)
+        result = results[-1]
+        if all(r == self.sdk.COMM_RX_CORRUPT for r in results):
+            return CorruptReplies(
+                f"servo {servo_id} on {self.port_name} sent a damaged status packet (bad checksum/CRC) in all "
+                f"{attempts} {what}; check its cable, connectors and the bus wiring",
+                result_code=result, servo_id=servo_id)
+        corrupt = sum(r == self.sdk.COMM_RX_CORRUPT for r in results)
+        how = f" ({corrupt} of the replies damaged)" if corrupt else ""
+        return ServoTimeout(
+            f"servo {servo_id} on {self.port_name} did not return its present position after {attempts} {what}"
+            f"{how}: no status packet within the reply timeout; check its power, cable, id and baud rate",
+            result_code=result, servo_id=servo_id)
+
+    def _watch_for_late_reply(self, servo_id: int) -> None:
+        """Listen up to LATE_REPLY_WATCH_MS for a status packet of ``servo_id``; ServoLate if one comes.
+
+        Uses the port's own timeout (MockPort's is virtual), so a dry run costs no wall-clock time.
+        """
+        if not callable(getattr(self.port, "setPacketTimeoutMillis", None)):
+            return
+        buffer = bytearray()
+        with self._port_guard(servo_id):
+            self.port.setPacketTimeoutMillis(LATE_REPLY_WATCH_MS)
+            while True:
+                available = self.port.getBytesAvailable()
+                if available:
+                    buffer += bytes(self.port.readPort(available))
+                    if self._status_packet_from(buffer, servo_id):
+                        raise self._late(servo_id)
+                elif self.port.isPacketTimeout():
+                    return
+                else:
+                    time.sleep(0.0002)
+
+    def _late(self, servo_id: int) -> ServoLate:
+        return ServoLate(f"servo {servo_id} on {self.port_name} answered late: its status packet arrived after "
+                         "the reply timeout (about 34 ms at 1 Mbaud); check its Return Delay Time and the "
+                         "adapter's latency timer", servo_id=servo_id)
+
+    def _status_packet_from(self, data: bytes | bytearray, servo_id: int) -> bool:
+        framing = wire.framing_for(self.family, self.protocol)
+        for raw, is_packet in wire.split_complete(bytearray(data), framing):
+            if not is_packet:
+                continue
+            frame = wire.parse(raw, framing, status=True)
+            if frame.checksum_ok and frame.packet_id == servo_id and \
+                    (framing == "v1" or frame.instruction == wire.INST_STATUS_V2):
+                return True
+        return False
+
+    def _write_byte_confirmed(self, servo_id: int, address: int, value: int, raise_status: bool = True) -> None:
         result, error = self.sdk.COMM_SUCCESS, 0
         for _ in range(1 + self.retries):  # rewriting the same byte is harmless, so retry
             self._before_transaction()
-            self._drop_stale_input()
-            result, error = self._ph.write1ByteTxRx(self.port, servo_id, address, value)
+            with self._port_guard(servo_id):
+                self._drop_stale_input()
+                result, error = self._ph.write1ByteTxRx(self.port, servo_id, address, value)
             self._raise_on_port_failure(result, servo_id)
             if result == self.sdk.COMM_SUCCESS:
                 break
@@ -214,17 +416,25 @@ class SdkBus(Bus):
                                f"address {address} ({self._ph.getTxRxResult(result)})",
                                result_code=result, servo_id=servo_id)
         self.last_status_errors[servo_id] = error
-        if error:
-            raise ServoStatusError(f"servo {servo_id} on {self.port_name} reports error 0x{error:02X}: "
-                                   f"{self._ph.getRxPacketError(error)}",
-                                   result_code=result, servo_id=servo_id, status_error=error)
+        if error and raise_status:
+            raise self._status_error(servo_id, error)
 
     def _drop_stale_input(self) -> None:
         """Discard bytes left over from an earlier, timed-out exchange before asking anew.
 
         Feetech's PortHandler.clearPort only flushes output, so a late status packet would be read
-        as the answer to the next question; we drop input ourselves for both backends.
+        as the answer to the next question; we drop input ourselves for both backends. The stale
+        bytes are read first (a recording port logs them, so the recording stays complete), and a
+        status packet among them from a servo that timed out is a late reply: ServoLate.
         """
+        available = getattr(self.port, "getBytesAvailable", None)
+        if callable(available):
+            pending = available()
+            if pending:
+                stale = bytes(self.port.readPort(pending))
+                for servo_id in sorted(self._timed_out_ids):
+                    if self._status_packet_from(stale, servo_id):
+                        raise self._late(servo_id)
         reset = getattr(self.port, "reset_input_buffer", None)
         if callable(reset):
             reset()
