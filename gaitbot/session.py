@@ -8,9 +8,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
-
-import numpy as np
 
 from gaitbot.bus.budget import check_rate
 from gaitbot.check import CheckReport, check_trajectory, trajectory_angles_deg
@@ -176,13 +173,3 @@ def joint_limits_ticks(config: RobotConfig) -> tuple[float, float]:
 def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:
     source, walker = build_walk(args)
     return source, walker, trajectory_of(walker)
-
-
-def write_json(path: Path, obj) -> None:
-    import json
-
-    path.write_text(json.dumps(obj, indent=2) + "\n")
-
-
-def angles_summary(trajectory: Trajectory) -> np.ndarray:
-    return np.degrees(trajectory.angles_rad)

@@ -21,7 +21,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
 
-from gaitbot.gait import TABLE1_LEG, OnlineWalker, WalkSettings, generate_walk  # noqa: E402
+from gaitbot.gait import TABLE1_LEG, OnlineWalker, generate_walk  # noqa: E402
 from gaitbot.gait.step_length import StepLengthInverse, boulic_step_length, step_length_to_rv_bisection  # noqa: E402
 
 

@@ -22,7 +22,7 @@ import numpy as np
 from .boulic import TABLE2_CYCLE_S
 from .geometry import LegGeometry
 from .planning import PlannedStep
-from .segments import CrouchSegment, GaitContext, SettleSegment, StepSegment, WalkState
+from .segments import CrouchSegment, GaitContext, SettleSegment, StepSegment
 from .step_length import StepLengthError, StepLengthInverse
 from .trajectory import HeelStrike, Trajectory
 
