@@ -15,11 +15,10 @@ Choices (also in ``docs/check.md``):
   name exists; otherwise exit 2 asking for ``--robot``. The config must match the recording (joint
   names and ids, servo models, backend and protocol) or the file is rejected (exit 2): the checks
   would be meaningless against another robot. A different baud rate or robot name is a warning.
-* Which goal writes count: ``walk_session`` writes the present pose as goal *before* torque on
-  (the servo is limp and already there), then streams the ramp, the walk and the stop. Frames
-  before the first torque-on write are checked for ids and packets but not for motion or timing;
-  everything from the first goal write after torque-on is the streamed series. A recording with no
-  torque-on write at all is taken as streamed from its first goal write.
+* Which goal writes count: all goal-position sync writes, in file order. ``walk_session`` writes
+  its first goal (the first pose, or the present pose when a start ramp follows) before torque on,
+  on the same deadline grid as every later frame, and the ramp, walk and stop share that grid; so
+  the goal writes of a session form one series at the configured rate, with no pauses.
 * Frame timing: the gap between consecutive streamed goal writes must not exceed
   ``MAX_GAP_PERIODS`` (1.5) periods of ``gait.rate_hz`` -- a frame more than half a period late
   left the servos without a new goal for that long. Time going backwards is an error too. Short
@@ -107,7 +106,7 @@ class FrameTiming:
         ms = 1000.0
         if self.n_frames < 2:
             return f"frame timing: {self.n_frames} streamed goal frame(s), no gaps to measure"
-        return (f"frame timing over {self.n_frames} streamed goal frames at {self.rate_hz:g} Hz "
+        return (f"frame timing over {self.n_frames} goal frames at {self.rate_hz:g} Hz "
                 f"(period {self.period_s * ms:.2f} ms): mean gap {self.mean_gap_s * ms:.2f} ms, "
                 f"p99 {self.p99_gap_s * ms:.2f} ms, worst {self.worst_gap_s * ms:.2f} ms "
                 f"({self.worst_gap_s / self.period_s:.2f} periods) at t={self.worst_gap_t_s:.3f} s "
@@ -418,17 +417,15 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
     known = set(column)
     model = config.joints[0].model
     goal_addr, goal_len = model.addr_goal_position, model.len_goal_position
-    torque_addr = model.addr_torque_enable
     signed = goal_len == 4  # Dynamixel X goal position is a signed 32-bit register
 
-    timing_t, timing_line = [], []  # every streamed goal write (valid or not) after torque-on
-    frames_t, frames_line, frames_rows, frames_streamed = [], [], [], []
-    torque_seen = False
+    timing_t, timing_line = [], []  # every goal write, valid or not
+    frames_t, frames_line, frames_rows = [], [], []
     for p in packets:
         if p.parsed is None or p.problem:
             issues.append(BusIssue("packet", "error", p.line_no, p.t_s,
                                    f"{p.direction} packet malformed: {p.problem}", p.hex))
-            if (p.direction == "tx" and torque_seen and p.parsed is not None
+            if (p.direction == "tx" and p.parsed is not None
                     and p.parsed.instruction == wire.INST_SYNC_WRITE):
                 timing_t.append(p.t_s)  # sent on time, ignored by the servos
                 timing_line.append(p.line_no)
@@ -445,25 +442,17 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
             frames_t.append(p.t_s)
             frames_line.append(p.line_no)
             frames_rows.append(row)
-            frames_streamed.append(torque_seen)
-            if torque_seen:
-                timing_t.append(p.t_s)
-                timing_line.append(p.line_no)
-        elif _is_torque_on(pk, torque_addr):
-            torque_seen = True
+            timing_t.append(p.t_s)
+            timing_line.append(p.line_no)
 
     if not frames_t:
         raise RecordingError(f"{path}: no goal-position frames to check (sync writes to address {goal_addr}); "
                              "was this recorded from a walk?")
-    streamed = np.array(frames_streamed, dtype=bool)
-    if not streamed.any():  # no torque-on write: the whole recording is the stream
-        streamed[:] = True
-        timing_t, timing_line = list(frames_t), list(frames_line)
     timing, timing_issues = _frame_timing(config.gait.rate_hz, np.array(timing_t), np.array(timing_line, dtype=int))
     issues += timing_issues
 
-    t_s, lines, ticks = _motion_samples(config, np.array(frames_t)[streamed], np.array(frames_line)[streamed],
-                                        np.array(frames_rows, dtype=float)[streamed])
+    t_s, lines, ticks = _motion_samples(config, np.array(frames_t), np.array(frames_line),
+                                        np.array(frames_rows, dtype=float))
     angles_deg = np.degrees(ticks_to_angles(config, ticks))
     joints = check_trajectory(config, t_s, angles_deg, margin_deg)
     order = {k: i for i, k in enumerate(BUS_KIND_ORDER)}
@@ -538,16 +527,6 @@ def _goal_row(p: _Logged, pk, goal_len: int, config: RobotConfig, column: dict[i
         issues.append(BusIssue("ids", "error", p.line_no, p.t_s, "goal frame repeats "
                                + ", ".join(_id_label(i, names) for i in repeated), p.hex))
     return row, issues
-
-
-def _is_torque_on(pk, torque_addr: int) -> bool:
-    if pk.address != torque_addr:
-        return False
-    if pk.instruction == wire.INST_WRITE:
-        return bool(pk.data[:1]) and pk.data[0] == 1
-    if pk.instruction == wire.INST_SYNC_WRITE:
-        return any(v[:1] == b"\x01" for v in pk.per_id_data.values())
-    return False
 
 
 def _frame_timing(rate_hz: float, t: np.ndarray, lines: np.ndarray) -> tuple[FrameTiming, list[BusIssue]]:
