@@ -17,9 +17,11 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
+
 from gaitbot.check import check_trajectory, trajectory_angles_deg
 from gaitbot.check_recording import check_recording, robot_for_recording
-from gaitbot.gait.trajectory import Trajectory, TrajectoryFileError
+from gaitbot.gait.trajectory import CSV_COLUMNS, Trajectory, TrajectoryFileError
 from gaitbot.session import UsageError, load_robot
 
 
@@ -50,7 +52,7 @@ def _check_trajectory_file(args, path: Path, margin: float) -> int:
     config = load_robot(args.robot)
     if path.suffix == ".csv" and path.is_file():
         _refuse_truncated_csv(path)
-    trajectory = Trajectory.load(path)
+    trajectory = _load_trajectory(path)
     report = check_trajectory(config, trajectory.t_s, trajectory_angles_deg(config, trajectory.angles_rad), margin)
     if args.json:
         print(json.dumps({"kind": "trajectory", "file": str(path), **report.to_dict()}, indent=2))
@@ -58,6 +60,25 @@ def _check_trajectory_file(args, path: Path, margin: float) -> int:
         print(f"{path}: trajectory checked against {config.name}")
         print(report.format_text())
     return 0 if report.ok else 1
+
+
+def _load_trajectory(path: Path) -> Trajectory:
+    """Trajectory.load, with a fast path for plain CSV files as ``generate`` writes them (numpy's C
+    reader: a one-hour file in a fraction of a second instead of over one). Anything the fast path
+    does not take as it is -- another header, a bad cell, a non-finite or non-increasing time -- goes
+    to Trajectory.load, whose one-line errors name the problem."""
+    if path.suffix == ".csv" and path.is_file():
+        try:
+            with open(path, encoding="utf-8") as f:
+                header = f.readline().strip()
+                if header == ",".join(CSV_COLUMNS):
+                    table = np.loadtxt(f, delimiter=",", ndmin=2, dtype=float)
+                    if (table.shape[1] == len(CSV_COLUMNS) and len(table) >= 2 and np.all(np.isfinite(table))
+                            and np.all(np.diff(table[:, 0]) > 0)):
+                        return Trajectory(table[:, 0].copy(), np.radians(table[:, 1:7]), table[:, 7:9].copy())
+        except (OSError, UnicodeDecodeError, ValueError):
+            pass
+    return Trajectory.load(path)
 
 
 def _refuse_truncated_csv(path: Path) -> None:

@@ -9,7 +9,7 @@ A recording is checked in two layers:
   ``check_trajectory`` as a trajectory file (position, tick range, wrap seam, velocity,
   acceleration), at the recorded send times.
 
-Choices (also in ``docs/check.md``):
+Choices:
 
 * Robot: ``--robot`` if given; otherwise the header's ``robot`` name if a shipped config of that
   name exists; otherwise exit 2 asking for ``--robot``. The config must match the recording (joint
