@@ -249,14 +249,6 @@ def test_heel_strikes_at_planned_footholds(name):
     np.testing.assert_allclose([g[1] for g in got[:len(strikes)]], expected, atol=1e-9 * w.L)
 
 
-CLEARANCE_BUG = pytest.mark.xfail(strict=True, reason=(
-    "segments.StepSegment._plan_swing stops its lift iteration after 8 rounds (for _ in range(8)) without "
-    "checking that the deficit is gone; near full reach _saturate_reach absorbs part of each lift increment "
-    "(the fixed point converges by a factor ~0.67 per round), so long steps taken from standing or after a "
-    "short step keep the swing sole below the clearance: 0.01913 L (0.75 from standing), 0.01973 L (0.7 from "
-    "standing), 0.01941 L (0.05 -> 0.75) against 0.02 L"))
-
-
 def swing_clearance_failures(w: Walk) -> list:
     out = []
     c = w.settings.clearance
@@ -271,7 +263,7 @@ def swing_clearance_failures(w: Walk) -> list:
     return out
 
 
-@pytest.mark.parametrize("name", [pytest.param(k, marks=CLEARANCE_BUG) if k == "mixed" else k for k in ALL_CASES])
+@pytest.mark.parametrize("name", ALL_CASES)
 def test_swing_clearance(name):
     """(e) whole swing sole at least the configured clearance above ground from 20% to 80% of each swing."""
     w = walk_for(name)
@@ -326,12 +318,6 @@ CONTINUITY_RATE_HZ = 960.0  # 16 x the 60 Hz stream: any true velocity jump stan
 CONTINUITY_CASES = ["constant_0.3"] + [k for k in ROBOT_CASES if not k.endswith("perturbed")]
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "velocity jump when the stance foot's contact switches from heel to toe: segments.root_of / "
-    "contact.grounded_ankle pivot the body about the heel while pitch >= 0 and about the toe once pitch < 0, "
-    "and the stance foot crosses pitch 0 with a non-zero pitch rate, so the root velocity jumps by "
-    "(foot length) x (pitch rate); the rear (pinned) leg's joint velocities, computed relative to the hip, "
-    "jump with it (45-150 deg/s knee jumps, the same at 60 and 960 Hz)"))
 @pytest.mark.parametrize("name", CONTINUITY_CASES)
 def test_joint_velocity_continuous(name):
     """(h) joint velocities continuous, judged at 960 Hz with the same cycle: J (see velocity_jumps) must
@@ -422,7 +408,7 @@ def sweep_walk(sl: float) -> Walk:
     return _SWEEP_CACHE[sl]
 
 
-@pytest.mark.parametrize("sl", [pytest.param(v, marks=CLEARANCE_BUG) if v >= 0.7 else v for v in SWEEP])
+@pytest.mark.parametrize("sl", SWEEP)
 def test_sweep_clearance(sl):
     failures = swing_clearance_failures(sweep_walk(sl))
     assert not failures, "; ".join(failures)
