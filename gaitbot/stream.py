@@ -419,9 +419,9 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             bus.set_torque(ids, True)
             state.next_deadline_s = first_sent_s + period_s
             if not at_start:
-                state.run(streamer(), ramp(present, walk[0]))
-            state.run(streamer(on_frame), walk[1:] if at_start else walk, is_walk=True)
-            state.run(streamer(), stop(walk[-2] if len(walk) > 1 else walk[-1], walk[-1]))
+                state.run(streamer(monitored=True), ramp(present, walk[0]))
+            state.run(streamer(on_frame, monitored=True), walk[1:] if at_start else walk, is_walk=True)
+            state.run(streamer(monitored=True), stop(walk[-2] if len(walk) > 1 else walk[-1], walk[-1]))
             outcome, error = "completed", None
         except (KeyboardInterrupt, Terminated) as exc:
             outcome, error = ("terminated" if isinstance(exc, Terminated) else "interrupted"), None
