@@ -414,14 +414,19 @@ def test_sweep_clearance(sl):
     assert not failures, "; ".join(failures)
 
 
-def stance_phases(w: Walk):
-    """(leg, first frame, last frame) of each stance: from the leg's heel strike to its toe-off."""
-    steps = w.walker.planned_steps
+def ground_intervals(w: Walk):
+    """(leg, first frame, last frame) of every time a foot is on the ground: from the start (or its
+    heel strike) to its next toe-off, or to the end of the walk (the closing step, settle and stand)."""
     u = w.walker.ctx.toe_off_u
-    for k, s in enumerate(steps[:-1]):
-        nxt = steps[k + 1]
-        t_off = nxt.start_s + u * (nxt.end_s - nxt.start_s)
-        yield s.leg, w.frame(s.end_s), int(math.floor(t_off * w.rate + 1e-9))
+    for leg in LEGS:
+        start = 0
+        for s in w.walker.planned_steps:
+            if s.leg != leg:
+                continue
+            t_off = s.start_s + u * (s.end_s - s.start_s)
+            yield leg, start, int(math.floor(t_off * w.rate + 1e-9))
+            start = w.frame(s.end_s)
+        yield leg, start, len(w.traj) - 1
 
 
 def contact_sequence(w: Walk, leg: str, a: int, b: int, eps: float) -> list:
@@ -435,21 +440,101 @@ def contact_sequence(w: Walk, leg: str, a: int, b: int, eps: float) -> list:
     return seq
 
 
+def jitter_failures(w: Walk) -> list:
+    """Jitter measured: while a foot is on the ground it rolls heel -> toe at most once and never back
+    (contact sequence one of [], H, T, H T; level within 1e-9 L counts as neither), and it never lifts off
+    and lands again (its lowest point stays on the ground)."""
+    out = []
+    for leg, a, b in ground_intervals(w):
+        seq = contact_sequence(w, leg, a, b, 1e-9 * w.L)
+        if seq not in ([], ["H"], ["T"], ["H", "T"]):
+            dy = w.pts[leg]["toe"][a:b + 1, 1] - w.pts[leg]["heel"][a:b + 1, 1]
+            back = a + int(np.argmax(np.minimum.accumulate(dy) < -1e-9 * w.L))  # first frame toe-down
+            after = dy[back - a:]
+            peak = back + int(np.argmax(after))
+            out.append(f"{leg} foot on the ground frames {a}-{b} rolls {'->'.join(seq)}: toe down from frame {back}, "
+                       f"then toe up again by {after.max() / w.L:.3g} L at frame {peak}")
+        low = w.lowest(leg)[a:b + 1]
+        if float(np.abs(low).max()) > 1e-9 * w.L:
+            out.append(f"{leg} foot leaves the ground within frames {a}-{b} ({low.max() / w.L:.3g} L)")
+    return out
+
+
 @pytest.mark.parametrize("sl", [0.0, 0.01, 0.02])
 def test_no_jitter_near_zero_step_length(sl):
-    """Jitter measured: within one stance the foot rolls heel -> toe at most once (never back), and
-    it never lifts off and lands again. Sole level within 1e-9 L counts as neither heel nor toe."""
+    """The paper's jitter near zero step length is gone (measure: see jitter_failures)."""
     w = make_walk(TABLE1_LEG, [sl] * 6)
-    L = w.L
-    phases = list(stance_phases(w))
-    assert len(phases) >= 5
-    for leg, a, b in phases:
-        seq = contact_sequence(w, leg, a, b, 1e-9 * L)
-        switches = len(seq) - 1 if seq else 0
-        assert switches <= 1, f"{leg} stance frames {a}-{b}: contact sequence {seq}"
-        assert seq in ([], ["H"], ["T"], ["H", "T"]), f"{leg} stance rolls back toe -> heel: {seq}"
-        low = w.lowest(leg)[a:b + 1]
-        assert float(np.abs(low).max()) <= 1e-9 * L, f"{leg} stance foot leaves the ground ({low.max() / L:.3g} L)"
+    intervals = list(ground_intervals(w))
+    assert len(intervals) >= 8
+    failures = jitter_failures(w)
+    assert not failures, "; ".join(failures)
+
+
+SETTLE_BUG = pytest.mark.xfail(strict=True, reason=(
+    "segments.SettleSegment rolls the rear foot flat with a cubic Hermite from its toe-down pitch and pitch "
+    "rate to 0 with zero end slope; when the pitch rate at the closing heel strike exceeds 3 |pitch| per "
+    "settle duration, the cubic overshoots: after a last step of 0.75 L (Table 1) the rear foot, on its toe "
+    "at -4.25 deg, rolls to +0.92 deg toe-up and back to level (+0.23 deg after 0.5 L; +0.071 deg after "
+    "xl430-biped's 0.1 m). The contact pivot switches toe -> heel with a non-zero pitch rate (contact."
+    "grounded_ankle), so the rear leg's joint velocities jump (ditch walk, cycle 1.2 s: right knee -17.7 -> "
+    "+4.35 deg/s within one frame at 3840 Hz, a jump of ~21 deg/s at 3840, 15360 and 61440 Hz alike) and the "
+    "foot rocks toe -> heel -> level"))
+
+
+def _jitter_param(k):
+    g, _, steps = ALL_CASES[k]
+    long_last = steps[-1] > (0.3 if g == TABLE1_LEG else 0.34 * g.leg_length)
+    return pytest.param(k, marks=SETTLE_BUG) if long_last else k
+
+
+@pytest.mark.parametrize("name", [_jitter_param(k) for k in ALL_CASES])
+def test_feet_roll_heel_to_toe_without_rocking(name):
+    """Every walk: each time a foot is on the ground it rolls heel -> toe at most once, never back."""
+    failures = jitter_failures(walk_for(name))
+    assert not failures, "; ".join(failures)
+
+
+@pytest.mark.parametrize("geometry_name, last", [
+    ("table1", 0.3), pytest.param("table1", 0.5, marks=SETTLE_BUG), pytest.param("table1", 0.75, marks=SETTLE_BUG),
+    ("xl430-biped", 0.06), pytest.param("xl430-biped", 0.1, marks=SETTLE_BUG),
+])
+def test_rear_foot_settles_flat_without_overshoot(geometry_name, last):
+    """After the closing step the rear foot, on its toe, rolls down to level and stops there: its pitch
+    never passes level to toe-up (which would switch its pivot to the heel and rock the foot)."""
+    if geometry_name == "table1":
+        g, s = TABLE1_LEG, WalkSettings()
+    else:
+        _, g, s = _robot(os.path.join(CONFIG_DIR, geometry_name + ".toml"))
+    w = make_walk(g, [last] * 3, s)
+    closing = w.walker.planned_steps[-1]
+    assert closing.closing
+    rear = "left" if closing.leg == "right" else "right"
+    e = w.frame(closing.end_s)
+    pitch = w.pts[rear]["pitch"][e:]
+    assert pitch[0] < 0, "the rear foot should be on its toe at the closing heel strike"
+    assert float(pitch.max()) <= 1e-9, f"rear foot pitch reaches {np.degrees(pitch.max()):+.4f} deg toe-up"
+    assert abs(pitch[-1]) <= 1e-12
+
+
+FINE_RATE_HZ = 15360.0  # 256 x 60 Hz
+
+
+@pytest.mark.parametrize("name", [
+    "constant_0.3", pytest.param("ditch_15", marks=SETTLE_BUG),
+    "xl430-biped-mixed", pytest.param("xl430-biped-perturbed", marks=SETTLE_BUG),
+])
+def test_joint_velocity_continuous_fine(name):
+    """(h) as test_joint_velocity_continuous but at 15360 Hz, where the bound 2 A dt is 1.56 deg/s for the
+    robots and 4.97 deg/s for Table 1's leg: a velocity jump bigger than that, anywhere in the walk
+    (steps, closing step, settle, stand), fails."""
+    g, s, steps = ALL_CASES[name]
+    w = make_walk(g, steps, WalkSettings(cycle_s=s.cycle_s, rate_hz=FINE_RATE_HZ, clearance=s.clearance))
+    a_max = 12000.0 * (2.4 / s.cycle_s) ** 2 if g == TABLE1_LEG else 12000.0
+    bound = 2 * a_max / FINE_RATE_HZ
+    j = velocity_jumps(np.degrees(w.traj.angles_rad), w.rate)
+    i, k = np.unravel_index(int(np.argmax(j)), j.shape)
+    assert j.max() < bound, (f"joint {k} velocity jumps {j.max():.2f} deg/s at frame {i + 3} of {len(w.traj)} "
+                             f"(bound {bound:.2f})")
 
 
 def test_jitter_measure_can_fail():
