@@ -59,9 +59,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("check", help="check a trajectory or a recorded run against the robot's limits")
     p.add_argument("file", help="trajectory (.csv, .npz) or bus recording (.jsonl)")
-    p.add_argument("--robot", help="robot config (default xl430-biped)")
+    p.add_argument("--robot", help="robot config (default: a recording's own robot, else xl430-biped)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.add_argument("--margin-deg", type=float, default=0.0, help="warn within this many degrees of a limit")
+    p.add_argument("--allow-partial", action="store_true",
+                   help="recordings: ignore a truncated last line (with a warning), e.g. after a crash")
 
     p = sub.add_parser("scan", help="list the servos that answer")
     p.add_argument("--robot", help="robot config (default xl430-biped)")
