@@ -134,7 +134,12 @@ def _robot_cases():
 
 
 ROBOT_CASES = _robot_cases()
-ALL_CASES = {**{k: (TABLE1_LEG, WalkSettings(), v) for k, v in TABLE1_CASES.items()}, **ROBOT_CASES}
+SETTINGS_CASES = {  # Table 1's leg with other settings: 50 Hz (1.346 s is not a whole number of frames), m = 0 and 5
+    "rate_50hz": (TABLE1_LEG, WalkSettings(rate_hz=50.0), [0.3, 0.55, 0.15, 0.0, 0.25]),
+    "intermediate_0": (TABLE1_LEG, WalkSettings(intermediate_steps=0), [0.1, 0.6, 0.2, 0.3]),
+    "intermediate_5": (TABLE1_LEG, WalkSettings(intermediate_steps=5), [0.1, 0.6, 0.2, 0.3]),
+}
+ALL_CASES = {**{k: (TABLE1_LEG, WalkSettings(), v) for k, v in TABLE1_CASES.items()}, **SETTINGS_CASES, **ROBOT_CASES}
 _CACHE: dict = {}
 
 
@@ -553,3 +558,82 @@ def test_generate_walk_equals_plan_walk_frames():
     b = trajectory_of(plan_walk(TABLE1_LEG, steps))
     assert np.array_equal(a.angles_rad, b.angles_rad) and np.array_equal(a.root_m, b.root_m)
     assert np.array_equal(a.t_s, b.t_s)
+
+
+# --------------------------------------------------------------------------------------------
+# the checks above can fail: each is run on a walk corrupted on purpose
+# --------------------------------------------------------------------------------------------
+def _corrupt(name: str, root_fn=None, angles_fn=None) -> str:
+    from gaitbot.gait import Trajectory
+
+    w = walk_for(name)
+    root, angles = w.traj.root_m.copy(), w.traj.angles_rad.copy()
+    if root_fn:
+        root_fn(w, root)
+    if angles_fn:
+        angles_fn(w, angles)
+    traj = Trajectory(w.traj.t_s, angles, root, w.traj.heel_strikes)
+    g = w.geometry
+    pts = {}
+    for j, leg in enumerate(LEGS):
+        rel = fk_leg(angles[:, 3 * j:3 * j + 3], g.thigh, g.shank, g.foot, g.ankle_height)
+        pts[leg] = {k: (v + root if k != "pitch" else v) for k, v in rel.items()}
+    key = f"corrupt-{len(_CACHE)}"
+    _CACHE[key] = Walk(g, w.settings, w.steps, w.walker, traj, pts, w.rate)
+    return key
+
+
+def _mid_step(w: Walk, k: int = 2) -> int:
+    s = w.walker.planned_steps[k]
+    return (w.frame(s.start_s) + w.frame(s.end_s)) // 2
+
+
+def _slide(w, root):
+    root[_mid_step(w):, 0] += 1e-7 * w.L  # the whole body (and so the stance foot) slides 1e-7 L once
+
+
+def _slide_far(w, root):
+    root[_mid_step(w):, 0] += 1e-5 * w.L  # past the 1e-6 L foothold tolerance
+
+
+def _sink(w, root):
+    root[_mid_step(w), 1] -= 2e-4 * w.L
+
+
+def _swing_low(w, root):
+    s = w.walker.planned_steps[2]
+    a, b = w.frame(s.start_s), w.frame(s.end_s)
+    root[a:b, 1] -= w.settings.clearance  # whole body lower by the clearance over one step
+
+
+def _not_standing(w, angles):
+    angles[-1, 1] += 1e-9
+
+
+def _kink(w, angles):
+    i = _mid_step(w)
+    angles[i:, 1] += np.radians(300.0 / w.rate) * np.arange(len(angles) - i)  # knee gains 300 deg/s at once
+
+
+@pytest.mark.parametrize("check, corruption", [
+    (test_locked_contact_point_never_slides, {"root_fn": _slide}),
+    (test_nothing_below_ground_and_someone_on_it, {"root_fn": _sink}),
+    (test_stance_foot_on_ground, {"root_fn": _sink}),
+    (test_heel_strikes_at_planned_footholds, {"root_fn": _slide_far}),
+    (test_swing_clearance, {"root_fn": _swing_low}),
+    (test_starts_and_ends_standing_feet_together, {"angles_fn": _not_standing}),
+])
+def test_checks_catch_corrupted_walks(check, corruption):
+    key = _corrupt("constant_0.3", **corruption)
+    with pytest.raises(AssertionError):
+        check(key)
+
+
+def test_robot_acceleration_check_catches_a_kink():
+    key = _corrupt("xl430-biped-constant", angles_fn=_kink)
+    ROBOT_CASES[key] = ROBOT_CASES["xl430-biped-constant"]
+    try:
+        with pytest.raises(AssertionError):
+            test_robot_joint_acceleration_under_servo_limit(key)
+    finally:
+        del ROBOT_CASES[key]
