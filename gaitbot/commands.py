@@ -13,7 +13,7 @@ from gaitbot.bus.recording import BusRecorder
 from gaitbot.clock import MonotonicClock, VirtualClock
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.calibration import angles_to_ticks, standing_ticks
-from gaitbot.session import (UsageError, joint_limits_ticks, load_robot, plan_summary, preflight,
+from gaitbot.session import (UsageError, gait_source, joint_limits_ticks, load_robot, plan_summary, preflight,
                              trajectory_for_robot)
 from gaitbot.stream import latency_timer_warning, walk_session
 
@@ -50,10 +50,7 @@ def cmd_plot(args) -> int:
     from gaitbot.plot import plot_trajectory  # matplotlib only when plotting
 
     trajectory = Trajectory.load(args.file)
-    source_args = args
-    from gaitbot.session import gait_source
-
-    source = gait_source(source_args)
+    source = gait_source(args)
     out = Path(args.output)
     plot_trajectory(trajectory, source.geometry, out, clearance=source.settings.clearance, title=Path(args.file).name)
     print(f"wrote {out}")
