@@ -47,7 +47,11 @@ def cmd_generate(args) -> int:
 
 
 def cmd_plot(args) -> int:
-    from gaitbot.plot import plot_trajectory  # matplotlib only when plotting
+    try:
+        import matplotlib  # noqa: F401  (only plotting needs it: the `plot` extra)
+    except ImportError:
+        raise UsageError("plotting needs matplotlib: pip install 'gaitbot[plot]'") from None
+    from gaitbot.plot import plot_trajectory
 
     trajectory = Trajectory.load(args.file)
     source = gait_source(args)
