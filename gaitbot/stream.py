@@ -358,10 +358,10 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
         their last goal, and a note says so.
 
     Servo faults during motion: with ``monitor_servos`` (the default) every frame of the start
-    ramp, the walk and the final ramp is followed by a read-back of all servos
+    ramp, the walk and the final ramp is followed by a read-back of one servo, each in turn
     (``bus.read_present_ticks``), so that a servo that stops answering, answers late, sends
     damaged packets or reports error bits (overload, overheating, input voltage) raises a
-    BusError naming it within that frame. The bus retries reads as its fault policy says
+    BusError naming it within ``len(ids)`` frames plus the bus's bounded retries. The bus retries reads as its fault policy says
     (see :class:`gaitbot.bus.sdk_bus.SdkBus`). The safe stop ramp is not read back: it must
     reach the healthy servos whatever the faulty one does.
     In every case, torque goes off if ``torque_off_on_exit``, and the bus is closed in a
@@ -391,11 +391,16 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
         return stop_ticks(previous_ticks, last_ticks, stand, max_velocity_ticks_per_s, max_accel_ticks_per_s2,
                           period_s)
 
+    next_checked = [0]
+
     def check_servos() -> None:
-        present = bus.read_present_ticks(ids)
-        silent = [i for i in ids if i not in present]
-        if silent:
-            raise ServoTimeout(f"servo {silent[0]} stopped answering reads during the walk", servo_id=silent[0])
+        """Read one servo back per frame, in turn: each servo is checked every len(ids) frames, and
+        the frame's bus time grows by one status packet, not by len(ids) of them (protocols without
+        sync read would otherwise ask every servo on its own every frame)."""
+        servo_id = ids[next_checked[0] % len(ids)]
+        next_checked[0] += 1
+        if servo_id not in bus.read_present_ticks([servo_id]):
+            raise ServoTimeout(f"servo {servo_id} stopped answering reads during the walk", servo_id=servo_id)
 
     def streamer(callback=None, monitored: bool = False) -> Streamer:
         monitor = check_servos if (monitored and monitor_servos) else None

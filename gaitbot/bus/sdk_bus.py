@@ -197,7 +197,7 @@ class SdkBus(Bus):
             except AttributeError:
                 pass
             raise PortError(f"serial port {self.port_name} failed: {exc} (the adapter was unplugged or the "
-                            "port closed); the servos keep their last goal", servo_id=servo_id) from exc
+                            "port closed)", servo_id=servo_id) from exc
 
     def ping(self, servo_id: int) -> bool:
         self._require_open()

@@ -1,0 +1,181 @@
+"""``gaitbot walk --port <pty>`` end to end against tools/servo_emulator.py: no hardware, real time.
+
+The real SDK PortHandler opens the emulator's pty, so these runs exercise the very code a walk on
+a robot runs. Expected goals come from the dry-run recording of the same plan
+(``gaitbot walk --dry-run --record`` + decode_goal_frames), never from the emulator.
+
+Cost: one 0.3 m walk per protocol (7-9.4 s of real time each, run two at a time) and one short
+walk per fault, which stops within about a second of the fault.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gaitbot.bus.log_decoder import decode_goal_frames
+from gaitbot.robot.config import load_robot_config
+
+from test_emulator import se  # noqa: E402 - the emulator module, loaded from tools/
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIGS = {"dxl2": ROOT / "config" / "xl430-biped.toml", "dxl1": ROOT / "config" / "ax12a-biped.toml",
+           "feetech-sts": ROOT / "config" / "sts3215-biped.toml"}
+WALK_TIMEOUT_S = 60  # a hang fails the test instead of the suite
+#: Stated stop bound: from the first frame the fault touches to the last packet the driver sends.
+#: Detection (4 reads of at most ~34 ms reply timeout + 40 ms late-reply watch) plus the stop ramp
+#: (under 1 s for the shipped configs) plus torque-off.
+STOP_BOUND_S = 2.0
+
+
+def scs_config(tmp_path: Path) -> Path:
+    """The STS biped with SCS0009 servos (Feetech, high byte first, no sync read): no shipped config has one."""
+    text = (ROOT / "config" / "sts3215-biped.toml").read_text()
+    text = text.replace('name = "sts3215-biped"', 'name = "scs0009-biped"').replace('"STS3215"', '"SCS0009"')
+    text = text.replace("zero_tick = 2048", "zero_tick = 512")
+    path = tmp_path / "scs0009-biped.toml"
+    path.write_text(text)
+    return path
+
+
+def gaitbot(*args: str, timeout: float = WALK_TIMEOUT_S) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "gaitbot.cli", *args], capture_output=True, text=True,
+                          timeout=timeout, stdin=subprocess.DEVNULL, cwd=ROOT)
+
+
+def emulator_for(config_path: Path, log_path: Path, faults=None):
+    robot = load_robot_config(config_path)
+    return se.ServoEmulator(se.EmulatorConfig(
+        robot.bus.backend, robot.bus.protocol, robot.models_by_id, robot.bus.baudrate, faults or se.Faults(),
+        str(log_path), robot.name, {j.name: j.id for j in robot.joints}))
+
+
+def walk_through_emulator(config_path: Path, workdir: Path, walk_args: list[str], faults=None):
+    """(process, emulator goal ticks, driver recording path, seconds) of one walk on the emulator's pty."""
+    workdir.mkdir(parents=True, exist_ok=True)
+    emu_log, record = workdir / "emulator-goals.jsonl", workdir / "walk.jsonl"
+    with emulator_for(config_path, emu_log, faults) as emulator:
+        start = time.monotonic()
+        proc = gaitbot("walk", "--robot", str(config_path), *walk_args, "--port", emulator.path,
+                       "--record", str(record))
+        elapsed = time.monotonic() - start
+    _, _, emulator_ticks = decode_goal_frames(emu_log)
+    return proc, emulator_ticks, record, elapsed
+
+
+def dry_run_ticks(config_path: Path, workdir: Path, walk_args: list[str]) -> np.ndarray:
+    record = workdir / "dry.jsonl"
+    proc = gaitbot("walk", "--robot", str(config_path), *walk_args, "--dry-run", "--record", str(record))
+    assert proc.returncode == 0, proc.stderr
+    return decode_goal_frames(record)[2]
+
+
+# --------------------------------------------------------------------------- full walks
+
+@pytest.fixture(scope="module")
+def full_walks(tmp_path_factory):
+    """One 0.3 m walk per protocol (each shipped config, plus an SCS0009 biped), two at a time."""
+    base = tmp_path_factory.mktemp("walks")
+    configs = dict(CONFIGS, **{"feetech-scs": scs_config(base)})
+    args = ["--distance", "0.3"]
+
+    def one(protocol):
+        work = base / protocol
+        result = walk_through_emulator(configs[protocol], work, args)
+        return protocol, (*result, dry_run_ticks(configs[protocol], work, args))
+
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        return dict(pool.map(one, configs))
+
+
+@pytest.mark.parametrize("protocol", ["dxl1", "dxl2", "feetech-sts", "feetech-scs"])
+def test_walk_through_the_emulator_sends_exactly_the_dry_run_goals(full_walks, protocol):
+    proc, emulator_ticks, record, _elapsed, dry_ticks = full_walks[protocol]
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "Walk completed" in proc.stdout
+    assert emulator_ticks.shape == dry_ticks.shape and emulator_ticks.shape[0] > 400
+    np.testing.assert_array_equal(emulator_ticks, dry_ticks)
+    np.testing.assert_array_equal(decode_goal_frames(record)[2], dry_ticks)  # the driver's own recording
+
+
+# --------------------------------------------------------------------------- faults
+
+SHORT = ["--steps", "0.03"]  # 4.6 s if nothing goes wrong; faults end it much sooner
+FAULT_FRAME = 30
+
+
+def check_failed_walk(proc, record: Path, emulator_ticks: np.ndarray, elapsed: float, *words: str):
+    """Exit 1, a message naming the servo and the fault, a strictly readable recording holding every
+    frame the servos received, and a bounded stop."""
+    out = proc.stdout + proc.stderr
+    assert proc.returncode == 1, out
+    assert "Traceback" not in out
+    for word in words:
+        assert word in out, out
+    _header, t_s, ticks = decode_goal_frames(record)  # strict: no truncated line
+    received = len(emulator_ticks)
+    np.testing.assert_array_equal(ticks[:received], emulator_ticks)
+    return t_s
+
+
+def test_a_servo_that_never_answers_stops_before_anything_moves(tmp_path):
+    faults = se.Faults(silent={3})
+    proc, emulator_ticks, record, elapsed = walk_through_emulator(CONFIGS["dxl2"], tmp_path, SHORT, faults)
+    check_failed_walk(proc, record, emulator_ticks, elapsed, "servo 3 did not answer a ping")
+    assert len(emulator_ticks) == 0  # no goal was sent
+    assert elapsed < 10
+
+
+@pytest.mark.parametrize("fault, words", [
+    (se.Faults(silent={3}, after_frames=FAULT_FRAME), ("servo 3", "did not return its present position")),
+    (se.Faults(late_s={3: 0.06}, after_frames=FAULT_FRAME), ("servo 3", "answered late")),
+    (se.Faults(corrupt_fraction=1.0, corrupt_ids={3}, after_frames=FAULT_FRAME), ("servo 3", "damaged status packet")),
+], ids=["silent", "late", "corrupt"])
+def test_servo_fault_mid_walk_stops_within_the_bound_at_stand(tmp_path, fault, words):
+    proc, emulator_ticks, record, elapsed = walk_through_emulator(CONFIGS["dxl2"], tmp_path, SHORT, fault)
+    t_s = check_failed_walk(proc, record, emulator_ticks, elapsed, *words, "ramped to the stand pose")
+    stop_s = t_s[-1] - t_s[FAULT_FRAME - 1]
+    assert stop_s < STOP_BOUND_S
+    assert len(emulator_ticks) < 200  # stopped long before the 276-frame walk would have ended
+
+
+@pytest.mark.parametrize("protocol, kind, words", [
+    ("dxl2", "overload", "reports overload"),
+    ("dxl1", "overheating", "reports overheating"),
+    ("feetech-sts", "voltage", "reports input voltage"),
+])
+def test_status_error_bits_stop_the_walk_naming_servo_and_fault(tmp_path, protocol, kind, words):
+    servo = load_robot_config(CONFIGS[protocol]).joints[1].id
+    faults = se.Faults(errors={servo: {kind}}, after_frames=FAULT_FRAME)
+    proc, emulator_ticks, record, elapsed = walk_through_emulator(CONFIGS[protocol], tmp_path, SHORT, faults)
+    t_s = check_failed_walk(proc, record, emulator_ticks, elapsed, f"servo {servo}", words)
+    assert t_s[-1] - t_s[FAULT_FRAME - 1] < STOP_BOUND_S
+
+
+def test_a_port_that_disappears_mid_walk_ends_at_once_with_a_complete_recording(tmp_path):
+    faults = se.Faults(close_after_frames=FAULT_FRAME + 10)
+    proc, emulator_ticks, record, elapsed = walk_through_emulator(CONFIGS["feetech-sts"], tmp_path, SHORT, faults)
+    t_s = check_failed_walk(proc, record, emulator_ticks, elapsed, "serial port", "failed",
+                            "the servos hold their last goal")
+    assert len(emulator_ticks) == FAULT_FRAME + 10
+    assert t_s[-1] - t_s[FAULT_FRAME + 9] < 0.5
+
+
+def test_rare_damaged_replies_are_retried_and_the_walk_completes(tmp_path):
+    faults = se.Faults(corrupt_fraction=0.05)
+    proc, emulator_ticks, _record, _elapsed = walk_through_emulator(CONFIGS["dxl1"], tmp_path, SHORT, faults)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    np.testing.assert_array_equal(emulator_ticks, dry_run_ticks(CONFIGS["dxl1"], tmp_path, SHORT))
+
+
+def test_extra_latency_within_the_timeout_is_tolerated(tmp_path):
+    faults = se.Faults(late_s={2: 0.004, 5: 0.004})
+    proc, emulator_ticks, _record, _elapsed = walk_through_emulator(CONFIGS["feetech-sts"], tmp_path, SHORT, faults)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    np.testing.assert_array_equal(emulator_ticks, dry_run_ticks(CONFIGS["feetech-sts"], tmp_path, SHORT))
