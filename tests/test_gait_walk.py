@@ -475,24 +475,7 @@ def test_no_jitter_near_zero_step_length(sl):
     assert not failures, "; ".join(failures)
 
 
-SETTLE_BUG = pytest.mark.xfail(strict=True, reason=(
-    "segments.SettleSegment rolls the rear foot flat with a cubic Hermite from its toe-down pitch and pitch "
-    "rate to 0 with zero end slope; when the pitch rate at the closing heel strike exceeds 3 |pitch| per "
-    "settle duration, the cubic overshoots: after a last step of 0.75 L (Table 1) the rear foot, on its toe "
-    "at -4.25 deg, rolls to +0.92 deg toe-up and back to level (+0.23 deg after 0.5 L; +0.071 deg after "
-    "xl430-biped's 0.1 m). The contact pivot switches toe -> heel with a non-zero pitch rate (contact."
-    "grounded_ankle), so the rear leg's joint velocities jump (ditch walk, cycle 1.2 s: right knee -17.7 -> "
-    "+4.35 deg/s within one frame at 3840 Hz, a jump of ~21 deg/s at 3840, 15360 and 61440 Hz alike) and the "
-    "foot rocks toe -> heel -> level"))
-
-
-def _jitter_param(k):
-    g, _, steps = ALL_CASES[k]
-    long_last = steps[-1] > (0.3 if g == TABLE1_LEG else 0.34 * g.leg_length)
-    return pytest.param(k, marks=SETTLE_BUG) if long_last else k
-
-
-@pytest.mark.parametrize("name", [_jitter_param(k) for k in ALL_CASES])
+@pytest.mark.parametrize("name", list(ALL_CASES))
 def test_feet_roll_heel_to_toe_without_rocking(name):
     """Every walk: each time a foot is on the ground it rolls heel -> toe at most once, never back."""
     failures = jitter_failures(walk_for(name))
@@ -500,8 +483,7 @@ def test_feet_roll_heel_to_toe_without_rocking(name):
 
 
 @pytest.mark.parametrize("geometry_name, last", [
-    ("table1", 0.3), pytest.param("table1", 0.5, marks=SETTLE_BUG), pytest.param("table1", 0.75, marks=SETTLE_BUG),
-    ("xl430-biped", 0.06), pytest.param("xl430-biped", 0.1, marks=SETTLE_BUG),
+    ("table1", 0.3), ("table1", 0.5), ("table1", 0.75), ("xl430-biped", 0.06), ("xl430-biped", 0.1),
 ])
 def test_rear_foot_settles_flat_without_overshoot(geometry_name, last):
     """After the closing step the rear foot, on its toe, rolls down to level and stops there: its pitch
@@ -525,8 +507,7 @@ FINE_RATE_HZ = 15360.0  # 256 x 60 Hz
 
 
 @pytest.mark.parametrize("name", [
-    "constant_0.3", pytest.param("ditch_15", marks=SETTLE_BUG),
-    "xl430-biped-mixed", pytest.param("xl430-biped-perturbed", marks=SETTLE_BUG),
+    "constant_0.3", "ditch_15", "xl430-biped-mixed", "xl430-biped-perturbed",
 ])
 def test_joint_velocity_continuous_fine(name):
     """(h) as test_joint_velocity_continuous but at 15360 Hz, where the bound 2 A dt is 1.56 deg/s for the

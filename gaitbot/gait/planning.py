@@ -27,18 +27,26 @@ def steps_for_distance(distance: float, max_step: float) -> list[float]:
 def perturb_steps(steps, sigma: float, seed: int | None, max_step: float) -> list[float]:
     """Add zero-mean Gaussian noise of standard deviation ``sigma`` to each step length.
 
-    The noise is centred (its mean removed) so the walk still covers the planned distance, then
-    each step is kept within [0, max_step]; with a seed the result is reproducible.
+    Each step stays within [0, max_step] and the total distance is kept: what clipping takes
+    from (or adds to) the total is spread over the steps that still have room. With a seed the
+    result is reproducible.
     """
     if not math.isfinite(sigma) or sigma < 0:
         raise StepLengthError(f"perturbation sigma must be 0 or more, got {sigma!r}")
     steps = np.asarray(steps, dtype=float)
     if sigma == 0 or len(steps) == 0:
         return steps.tolist()
-    noise = np.random.default_rng(seed).normal(0.0, sigma, len(steps))
-    if len(steps) > 1:
-        noise -= noise.mean()
-    return np.clip(steps + noise, 0.0, max_step).tolist()
+    total = float(steps.sum())
+    out = np.clip(steps + np.random.default_rng(seed).normal(0.0, sigma, len(steps)), 0.0, max_step)
+    for _ in range(len(steps) + 1):
+        missing = total - float(out.sum())
+        room = (max_step - out) if missing > 0 else out
+        free = room > 1e-15
+        if abs(missing) <= 1e-12 * max(1.0, total) or not free.any():
+            break
+        share = room[free] / room[free].sum()
+        out[free] = np.clip(out[free] + missing * share, 0.0, max_step)
+    return out.tolist()
 
 
 @dataclass(frozen=True)

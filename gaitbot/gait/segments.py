@@ -249,26 +249,48 @@ class CrouchSegment:
         return WalkState(True, self.anchor, self.anchor, foot, np.zeros(3), 0.0, 0.0, 0.0)
 
 
+def settle_profile(u, rate0: float):
+    """g(u) from 1 to 0 on [0, 1] that never passes 0, with g'(0) = rate0 and g'(1) = 0.
+
+    (1 - u)^2 (1 + c u), c = rate0 + 2, stays >= 0 for rate0 >= -3 (it may first rise when
+    rate0 > 0); steeper starts use (1 - u)^n, n = -rate0. A cubic Hermite with the same ends
+    would pass 0 when rate0 < -3."""
+    u = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
+    rate0 = float(rate0)
+    if rate0 >= -3.0:
+        return (1.0 - u) ** 2 * (1.0 + (rate0 + 2.0) * u)
+    return (1.0 - u) ** (-rate0)
+
+
+def _settle_pitch(u, pitch0: float, rate0: float):
+    """A sole pitch settling to level from pitch0 (rate0 per unit u) without passing level."""
+    if pitch0 == 0.0:
+        return np.zeros_like(np.asarray(u, dtype=float))
+    return pitch0 * settle_profile(u, rate0 / pitch0)
+
+
 class SettleSegment:
     """After the closing step: the front foot moves (relative to the hip) to the crouch while the
-    rear foot, pinned on the ground, rolls flat. Ends with both feet flat side by side."""
+    rear foot, pinned on the ground, rolls flat. Ends with both feet flat side by side.
+
+    Both sole pitches settle to level along ``settle_profile``: a cubic Hermite overshoots level
+    after a long last step, which would switch the pivot (heel <-> toe) and rock the foot."""
 
     def __init__(self, ctx: GaitContext, state: WalkState) -> None:
         self.ctx, self.state = ctx, state
         self.n_frames = ctx.step_frames
         g = ctx.geometry
         self.foot_end = foot_of(g, crouch_pose(g, np.array([ctx.crouch_knee_rad])))[0]
-        duration = self.n_frames / ctx.rate_hz
-        self._rate0 = state.foot_rate_stance * duration
-        self._pitch_rate0 = state.pitch_rate_rear * duration
+        self._duration = self.n_frames / ctx.rate_hz
+        self._rate0 = state.foot_rate_stance * self._duration
 
     def evaluate(self, u):
         u = np.atleast_1d(np.asarray(u, dtype=float))
         s, g = self.state, self.ctx.geometry
         foot = hermite_segment(u, s.foot_stance, self._rate0, self.foot_end, np.zeros(3))
+        foot[:, 2] = _settle_pitch(u, float(s.foot_stance[2]), float(self._rate0[2]))
         root = root_of(g, s.anchor_stance, foot)
-        pitch = hermite_segment(u, np.array([s.pitch_rear]), np.array([self._pitch_rate0]),
-                                np.zeros(1), np.zeros(1))[:, 0]
+        pitch = _settle_pitch(u, s.pitch_rear, s.pitch_rate_rear * self._duration)
         rear = np.column_stack([grounded_ankle(g, s.anchor_rear, pitch) - root, pitch])
         return _assemble(s.stance_left, angles_of(g, foot, "settling"), angles_of(g, rear, "settling"), root)
 
