@@ -130,6 +130,8 @@ def cmd_walk(args) -> int:
     finally:
         if recorder is not None:
             recorder.close()
+    for note in getattr(bus, "open_notes", []):
+        print(f"note: {note}", file=sys.stderr)
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     mode = "dry run (mock bus)" if args.dry_run else f"{config.bus.backend} on {port}"
