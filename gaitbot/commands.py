@@ -53,6 +53,15 @@ def cmd_plot(args) -> int:
         raise UsageError("plotting needs matplotlib: pip install 'gaitbot[plot]'") from None
     from gaitbot.plot import plot_trajectory
 
+    if Path(args.file).suffix == ".npz":
+        from gaitbot.gait.eigen import is_model_file
+
+        if is_model_file(args.file):
+            from gaitbot.plot import plot_eigen_model
+
+            plot_eigen_model(args.file, Path(args.output))
+            print(f"wrote {args.output}")
+            return 0
     trajectory = Trajectory.load(args.file)
     source = gait_source(args)
     out = Path(args.output)
@@ -134,7 +143,12 @@ def cmd_walk(args) -> int:
         print(f"note: {note}", file=sys.stderr)
     if sys.stderr.isatty():
         sys.stderr.write("\n")
-    mode = "dry run (mock bus)" if args.dry_run else f"{config.bus.backend} on {port}"
+    if not args.dry_run:
+        mode = f"{config.bus.backend} on {port}"
+    elif args.realtime:
+        mode = "dry run (mock bus, paced in real time)"
+    else:
+        mode = "dry run (mock bus, simulated clock: timing figures are exact by construction; --realtime paces it)"
     print(f"{config.name}: {mode}: {len(walker.planned_steps)} heel strikes, "
           f"{trajectory.root_m[-1, 0]:.3f} m planned. {result.message()}")
     if result.walk_stats is not None:
@@ -166,3 +180,9 @@ def cmd_check(args) -> int:
     from gaitbot.check_command import run_check
 
     return run_check(args)
+
+
+def cmd_eigen(args) -> int:
+    from gaitbot.eigen_command import run_eigen
+
+    return run_eigen(args)
