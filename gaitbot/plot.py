@@ -78,3 +78,45 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
     ax_stick.legend(fontsize=8, loc="upper left")
     fig.savefig(out, dpi=110)
     plt.close(fig)
+
+
+def plot_eigen_model(model_path, out: Path, n_show: int = 3) -> None:
+    """Eigen-motions of an eigen-gait model (seed 004 Fig. 3): per eigen-motion, each joint's mean
+    cycle (solid) and mean +- 2 sqrt(eigenvalue) times the eigen-motion (dashed +, dotted -)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from gaitbot.gait.eigen import EigenGaitModel
+
+    model = EigenGaitModel.load(model_path)
+    k = min(n_show, len(model.eigenvalues))
+    s = np.linspace(0.0, 1.0, 201)
+    mean = np.degrees(model.poses(s, np.zeros(0)))
+    fig, axes = plt.subplots(k, 3, figsize=(13, 3.2 * k + 0.6), sharex=True, squeeze=False, constrained_layout=True)
+    share = model.variance_explained
+    for i in range(k):
+        delta = 2.0 * np.sqrt(model.eigenvalues[i]) * np.degrees(model.eigen_motion(s, i))
+        for j, joint in enumerate(("hip", "knee", "ankle")):
+            ax = axes[i, j]
+            for side, colour in ((0, "tab:blue"), (1, "tab:red")):
+                c = 3 * side + j
+                ax.plot(100 * s, mean[:, c], color=colour, lw=1.5, label=f"{joint} {'left' if side == 0 else 'right'} mean")
+                ax.plot(100 * s, mean[:, c] + delta[:, c], "--", color=colour, lw=1.0)
+                ax.plot(100 * s, mean[:, c] - delta[:, c], ":", color=colour, lw=1.0)
+            ax.grid(alpha=0.3)
+            if i == 0:
+                ax.set_title(f"{joint} (deg, flexion +)")
+            if j == 0:
+                kept = " (kept)" if i < model.n_components else ""
+                ax.set_ylabel(f"eigen-motion {i + 1}{kept}\n{100 * share[i]:.1f}% of variance")
+            if i == k - 1:
+                ax.set_xlabel("aligned cycle phase (%), 0 = left heel strike")
+            if i == 0 and j == 2:
+                ax.legend(fontsize=7, loc="best")
+    labels = ", ".join(f"{v:g}" for v in sorted(set(np.round(model.labels, 4))))
+    fig.suptitle(f"{Path(str(model_path)).name}: mean cycle (solid), mean + 2 sd x eigen-motion (dashed), "
+                 f"mean - 2 sd (dotted); {len(model.labels)} cycles, step lengths {labels} m", fontsize=9)
+    fig.savefig(out, dpi=100)
+    plt.close(fig)

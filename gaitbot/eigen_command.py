@@ -1,0 +1,148 @@
+"""``gaitbot eigen fit`` and ``gaitbot eigen synth``: wiring from files and a robot to gaitbot.gait.eigen.
+
+fit: each EXAMPLE is a trajectory file (.npz with heel strikes, or .csv whose heel strikes are
+found from foot contact with the robot's leg); its steady cycles are examples, labelled with the
+walk's step length. Prints the variance explained per eigen-motion.
+
+synth: a walk at ``--step-length`` (optionally going to ``--to-step-length``), written in the
+trajectory format; optionally forced through ``--pose-deg`` at ``--pose-time`` seconds into each
+synthesised cycle (seed 004 eq. 13). The walk starts standing and ends standing: the walker's
+first two steps, the synthesised cycles, the walker's closing step (see gait/eigen/synth.py).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, ExampleError, FitOptions, cycles_from_trajectory,
+                                fit_model, synthesize_walk, walk_label)
+from gaitbot.gait.trajectory import WALKING_JOINTS, Trajectory
+from gaitbot.robot.gait_setup import leg_geometry, walk_settings
+from gaitbot.session import UsageError, load_robot
+
+POSE_TOL_DEG = 0.1
+
+
+def run_eigen(args) -> int:
+    return {"fit": run_fit, "synth": run_synth}[args.eigen_command](args)
+
+
+def load_examples(paths, geometry):
+    """Example cycles of every file, each labelled with its walk's step length; and the frame rate."""
+    examples, rates = [], []
+    for path in paths:
+        trajectory = Trajectory.load(path)
+        cycles = cycles_from_trajectory(trajectory, geometry, source=str(path))
+        label = walk_label(cycles)
+        examples += [c.__class__(c.angles_rad, c.duration_s, c.right_strike_phase, label, c.source) for c in cycles]
+        rates.append(1.0 / float(np.median(np.diff(trajectory.t_s))))
+    if max(rates) - min(rates) > 1e-6 * max(rates):
+        raise UsageError(f"the example files have different frame rates ({min(rates):g} to {max(rates):g} Hz)")
+    return examples, rates[0]
+
+
+def run_fit(args) -> int:
+    out = Path(args.output)
+    if out.suffix != ".npz":
+        raise UsageError(f"-o {out}: the model file must end in .npz")
+    config = load_robot(args.robot)
+    geometry = leg_geometry(config)
+    options = FitOptions(samples=args.samples, basis=args.basis, n_basis=args.n_basis, roughness=args.roughness,
+                         pose_variance=args.pose_variance, motion_variance=args.variance, components=args.components,
+                         align=args.align, label_degree=args.label_degree)
+    examples, rate = load_examples(args.examples, geometry)
+    model = fit_model(examples, geometry, rate, options, periodic=args.basis == "fourier")
+    model.save(out)
+    labels = sorted(set(np.round(model.labels, 6)))
+    print(f"wrote {out}: {len(examples)} example cycles from {len(args.examples)} files, step lengths "
+          f"{', '.join(f'{v:g}' for v in labels)} m")
+    pose_share = np.cumsum(model.pose_eigenvalues)[model.pose_dims - 1] / model.pose_eigenvalues.sum()
+    print(f"pose PCA: {model.pose_dims} of 6 axes keep {100 * pose_share:.2f}% of the pose variance")
+    print("eigen-motion  variance %  cumulative %")
+    cumulative = np.cumsum(model.variance_explained)
+    for i, (share, total) in enumerate(zip(model.variance_explained, cumulative), start=1):
+        mark = "  kept" if i <= model.n_components else ""
+        print(f"{i:12d}  {100 * share:10.3f}  {100 * total:12.3f}{mark}")
+    print(f"{model.n_components} eigen-motions kept ({100 * cumulative[model.n_components - 1]:.2f}% of the variance)")
+    return 0
+
+
+def _parse_pose(text: str) -> np.ndarray:
+    items = text.split(",")
+    if len(items) != len(WALKING_JOINTS):
+        raise UsageError(f"--pose-deg: give {len(WALKING_JOINTS)} angles in degrees ({', '.join(WALKING_JOINTS)}), "
+                         f"got {len(items)}")
+    try:
+        values = np.array([float(v) for v in items])
+    except ValueError:
+        raise UsageError(f"--pose-deg: {text!r} holds a value that is not a number") from None
+    if not np.all(np.isfinite(values)):
+        raise UsageError("--pose-deg: every angle must be a finite number of degrees")
+    return values
+
+
+def _check_pose_limits(config, pose_deg: np.ndarray) -> None:
+    limits = {j.name: (j.min_deg, j.max_deg) for j in config.joints}
+    for name, value in zip(WALKING_JOINTS, pose_deg):
+        if name in limits:
+            lo, hi = limits[name]
+            if not (lo <= value <= hi):
+                raise UsageError(f"--pose-deg: {name} {value:g} deg is outside its joint limits {lo:g} to {hi:g} deg "
+                                 f"({config.name})")
+
+
+def run_synth(args) -> int:
+    out = Path(args.output)
+    if out.suffix not in (".csv", ".npz"):
+        raise UsageError(f"-o {out}: the output must end in .csv or .npz")
+    model = EigenGaitModel.load(args.model)
+    config = load_robot(args.robot)
+    if leg_geometry(config) != model.geometry:
+        raise UsageError(f"--robot {config.name}: its leg differs from the leg the model {args.model} was fitted with")
+    settings = walk_settings(config)
+    for name in ("step_length", "to_step_length"):
+        value = getattr(args, name)
+        if value is not None and not math.isfinite(value):
+            raise UsageError(f"--{name.replace('_', '-')} must be a finite number of metres, got {value!r}")
+    if args.step_length > config.gait.max_step_m or (args.to_step_length or 0) > config.gait.max_step_m:
+        raise UsageError(f"step lengths must be at most max_step_m = {config.gait.max_step_m:g} m ({config.name})")
+    components = args.components
+    if components is not None and not (1 <= components <= len(model.eigenvalues)):
+        raise UsageError(f"--components {components}: the model has {len(model.eigenvalues)} eigen-motions "
+                         f"(fit with more example walks for more)")
+    alphas = None
+    pose_report = None
+    if args.pose_deg is not None:
+        if args.pose_time is None:
+            raise UsageError("--pose-deg needs --pose-time (seconds into each synthesised cycle)")
+        if args.to_step_length is not None:
+            raise UsageError("--pose-deg forces every cycle through one pose: leave out --to-step-length")
+        pose_deg = _parse_pose(args.pose_deg)
+        _check_pose_limits(config, pose_deg)
+        duration, warp, _ = model.timing_for(args.step_length)
+        if not (0.0 <= args.pose_time < duration):
+            raise UsageError(f"--pose-time must be from 0 to below the cycle's {duration:.4g} s, got {args.pose_time:g}")
+        s_prime = float(model.aligned_phase(args.pose_time / duration, warp))
+        alpha, miss = model.through_pose(np.radians(pose_deg), s_prime, model.coefficients_for(args.step_length, components))
+        worst = float(np.degrees(np.abs(miss)).max())
+        if worst > POSE_TOL_DEG:
+            j = int(np.argmax(np.abs(miss)))
+            raise EigenModelError(f"--pose-deg cannot be reached: the model's {len(alpha)} eigen-motions and "
+                                  f"{model.pose_dims} pose axes miss {WALKING_JOINTS[j]} by {worst:.3g} deg "
+                                  f"(try --components up to {len(model.eigenvalues)}, or fit with --pose-variance 1)")
+        alphas = [alpha] * (args.cycles + 1)
+        pose_report = (args.pose_time, worst)
+    walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,
+                           components=components, alphas=alphas)
+    walk.save(out)
+    xs = [h.x_m for h in walk.heel_strikes]
+    print(f"wrote {out}: {len(walk)} frames, {walk.t_s[-1]:.2f} s, {len(xs)} heel strikes, "
+          f"{walk.root_m[-1, 0]:.4f} m; step lengths {', '.join(f'{d:.4f}' for d in np.diff(xs))} m")
+    if pose_report is not None:
+        starts = [h.t_s for h in walk.heel_strikes if h.leg == "left"][:args.cycles]
+        times = ", ".join(f"{t + pose_report[0]:.3f}" for t in starts)
+        print(f"pose reached to {pose_report[1]:.3g} deg at t = {times} s")
+    return 0

@@ -1,0 +1,10 @@
+"""Eigen-gaits (seed 004): functional PCA of example cycles, and synthesis from coefficients,
+step-length labels, or a required pose. Pure numpy/scipy; I/O only for the model ``.npz``."""
+
+from .examples import ExampleCycle, ExampleError, cycles_from_trajectory, detect_heel_strikes, walk_label
+from .model import EigenGaitModel, EigenModelError, FitOptions, fit_model, is_model_file
+from .synth import root_from_contact, synthesize_cycles, synthesize_walk
+
+__all__ = ["ExampleCycle", "ExampleError", "cycles_from_trajectory", "detect_heel_strikes", "walk_label",
+           "EigenGaitModel", "EigenModelError", "FitOptions", "fit_model", "is_model_file", "root_from_contact",
+           "synthesize_cycles", "synthesize_walk"]

@@ -1,0 +1,114 @@
+"""Example cycles from trajectory files (seed 004 section 3: cycle segmentation).
+
+A cycle runs from a left heel strike to the next left heel strike (two steps, gait-model.md
+section 1). Trajectory ``.npz`` files carry their heel strikes; CSV files do not, so heel strikes
+are detected from foot contact with forward kinematics: in the body frame, a leg's foot is in the
+air while its lowest sole point is more than ``contact_tol_m`` above the other foot's; its heel
+strike is the first frame at which it comes back down to (nearly) the other foot's level.
+
+Only the steady part of a walk gives examples: a generated walk starts from standing (its first
+step starts at rest) and ends with a closing step, so cycles that start at the first heel strike
+or end at the last one are dropped. A walk's label is its step length: the mean distance between
+consecutive heel strikes inside the cycles kept (world x of the heel at each strike).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..contact import leg_pitch, lowest_sole_y
+from ..geometry import LegGeometry, ankle_position, foot_points
+from ..trajectory import HeelStrike, Trajectory
+
+CONTACT_TOL_FRACTION = 0.01  # of the leg length: 2.2 mm for a 0.22 m leg
+
+
+class ExampleError(ValueError):
+    """An example file cannot give example cycles; the message names the file and why."""
+
+
+@dataclass(frozen=True)
+class ExampleCycle:
+    """One cycle: frames (n, 6) joint angles in radians at phases k/n, its duration, the phase of
+    the right heel strike inside it, and its label (step length, metres)."""
+
+    angles_rad: np.ndarray
+    duration_s: float
+    right_strike_phase: float
+    step_length_m: float
+    source: str = ""
+
+
+def foot_heights_in_body(geometry: LegGeometry, angles_rad: np.ndarray) -> np.ndarray:
+    """(N, 2) height of the lowest sole point of the left and right foot relative to the hip."""
+    out = []
+    for side in (0, 1):
+        q = angles_rad[:, 3 * side:3 * side + 3]
+        out.append(lowest_sole_y(geometry, ankle_position(geometry, q[:, 0], q[:, 1]), leg_pitch(q)))
+    return np.column_stack(out)
+
+
+def heel_world_x(geometry: LegGeometry, trajectory: Trajectory, frame: int, leg: str) -> float:
+    side = 0 if leg == "left" else 1
+    q = trajectory.angles_rad[frame, 3 * side:3 * side + 3]
+    ankle = ankle_position(geometry, q[0], q[1])
+    heel, _ = foot_points(geometry, ankle, leg_pitch(q))
+    return float(heel[0] + trajectory.root_m[frame, 0])
+
+
+def detect_heel_strikes(trajectory: Trajectory, geometry: LegGeometry, contact_tol_m: float | None = None):
+    """Heel strikes from foot contact (for files without them): list of HeelStrike.
+
+    A foot is in the air once its lowest sole point is more than ``contact_tol_m`` (default
+    CONTACT_TOL_FRACTION of the leg) above the other foot's; its heel strike is the first frame
+    after that at which it is back within a tenth of that of the other foot's level."""
+    tol = CONTACT_TOL_FRACTION * geometry.leg_length if contact_tol_m is None else contact_tol_m
+    heights = foot_heights_in_body(geometry, trajectory.angles_rad)
+    strikes = []
+    for side, leg in ((0, "left"), (1, "right")):
+        gap = heights[:, side] - heights[:, 1 - side]
+        airborne = False
+        for k, value in enumerate(gap):
+            if value > tol:
+                airborne = True
+            elif airborne and value <= 0.1 * tol:
+                strikes.append(HeelStrike(float(trajectory.t_s[k]), leg, heel_world_x(geometry, trajectory, k, leg)))
+                airborne = False
+    return sorted(strikes, key=lambda h: h.t_s)
+
+
+def _frame_of(trajectory: Trajectory, t_s: float) -> int:
+    return int(np.argmin(np.abs(trajectory.t_s - t_s)))
+
+
+def cycles_from_trajectory(trajectory: Trajectory, geometry: LegGeometry, source: str = "",
+                           keep_ends: bool = False) -> list[ExampleCycle]:
+    """The steady cycles of a walk (left heel strike to left heel strike), labelled by step length."""
+    strikes = list(trajectory.heel_strikes) or detect_heel_strikes(trajectory, geometry)
+    if not keep_ends:
+        strikes = strikes[1:-1]  # the first step starts from rest, the last one closes the feet
+    lefts = [i for i, h in enumerate(strikes) if h.leg == "left"]
+    cycles = []
+    for a, b in zip(lefts, lefts[1:]):
+        inner = strikes[a:b + 1]
+        rights = [h for h in inner if h.leg == "right"]
+        if len(inner) != 3 or len(rights) != 1:
+            continue  # not two alternating steps
+        k0, k1 = _frame_of(trajectory, inner[0].t_s), _frame_of(trajectory, inner[-1].t_s)
+        if k1 - k0 < 8:
+            continue
+        duration = float(trajectory.t_s[k1] - trajectory.t_s[k0])
+        phase = float((rights[0].t_s - inner[0].t_s) / duration)
+        step = float(np.mean(np.diff([h.x_m for h in inner])))
+        cycles.append(ExampleCycle(trajectory.angles_rad[k0:k1].copy(), duration, phase, step, source))
+    if not cycles:
+        raise ExampleError(f"{source or 'trajectory'}: no complete steady cycle (left heel strike, right, left) "
+                           f"found among {len(trajectory.heel_strikes) or 'the detected'} heel strikes")
+    return cycles
+
+
+def walk_label(cycles: list[ExampleCycle]) -> float:
+    """A walk's step length: the mean over its steady cycles."""
+    return float(np.mean([c.step_length_m for c in cycles]))

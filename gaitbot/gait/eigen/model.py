@@ -1,0 +1,304 @@
+"""Eigen-gaits (seed 004): fit a functional-PCA model to example cycles, save/load it, synthesise cycles.
+
+Fit (``fit_model``), following seed 004:
+1. each cycle is resampled to ``samples`` frames (section 3 (2)) and DTW-aligned to a reference,
+   the example whose label is the median (section 3 (1)); the warps are kept (see align.py);
+2. PCA of all aligned poses; the leading axes U explaining ``pose_variance`` (default 95%) are
+   kept (eq. 1);
+3. each reduced channel of each example is fitted by penalised least squares in a Fourier basis
+   (periodic cycles) or a B-spline basis (section 4.1, eq. 3);
+4. functional PCA of the coefficient vectors: ``N^-1 C^T C W b = lambda b`` (eq. 10), W the
+   basis Gram matrix (block diagonal over the reduced channels). Solved in its symmetric form
+   ``L^T (N^-1 C^T C) L u = lambda u`` with W = L L^T and b = L^-T u, so the eigen-motions
+   ``xi_i(s) = Phi(s) b_i`` are orthonormal in L2 and an example's score is
+   ``alpha_i = b_i^T W (c - c_mean)``. The leading eigen-motions explaining more than
+   ``motion_variance`` (default 95%, eq. 11) are kept.
+
+Synthesis (section 5): the reduced motion ``mean(s) + sum alpha_i xi_i(s)`` (eq. 12), back-projected
+``pose_mean + x U^T`` (eq. 14). Coefficients come directly, from a label (a polynomial regression
+of the examples' scores, warps, durations and right-strike phases on their step length), or from a
+required pose p at a time t' by ``alpha = alpha0 + pinv(Delta) (p - x(t'; alpha0))`` with
+``Delta = [xi_1(t') ... xi_m(t')]`` (eq. 13, applied to the change from a base motion alpha0 so
+that the least-norm solution stays near the base walk rather than near the mean).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..geometry import LegGeometry
+from .align import align_to_reference, resample_cycle, sample_phases
+from .basis import fit_coefficients, make_basis
+from .examples import ExampleCycle
+
+MODEL_KIND = "gaitbot-eigen-gait"
+MODEL_VERSION = 1
+
+
+class EigenModelError(ValueError):
+    """Bad input to fitting or synthesis (too few examples, unreachable pose, ...): one line for people."""
+
+
+@dataclass(frozen=True)
+class FitOptions:
+    samples: int = 100
+    basis: str = "fourier"
+    n_basis: int = 31
+    roughness: float = 0.0
+    pose_variance: float = 0.95
+    motion_variance: float = 0.95
+    components: int | None = None  # fixed number of eigen-motions (overrides motion_variance)
+    align: str = "dtw"  # or "none"
+    dtw_band: float = 0.1
+    label_degree: int = 2
+
+    def __post_init__(self) -> None:
+        if self.samples < 8:
+            raise EigenModelError(f"samples must be 8 or more, got {self.samples}")
+        if self.basis not in ("fourier", "bspline"):
+            raise EigenModelError(f"basis must be fourier or bspline, got {self.basis!r}")
+        if not (1 <= self.n_basis <= self.samples):
+            raise EigenModelError(f"n_basis must be from 1 to samples ({self.samples}), got {self.n_basis}")
+        if self.basis == "fourier" and self.n_basis % 2 == 0:
+            raise EigenModelError(f"a Fourier basis needs an odd n_basis (1 + 2 per harmonic), got {self.n_basis}")
+        for name in ("pose_variance", "motion_variance"):
+            v = getattr(self, name)
+            if not (0.0 < v <= 1.0):
+                raise EigenModelError(f"{name} must be in (0, 1], got {v}")
+        if self.roughness < 0:
+            raise EigenModelError(f"roughness must be 0 or more, got {self.roughness}")
+        if self.align not in ("dtw", "none"):
+            raise EigenModelError(f"align must be dtw or none, got {self.align!r}")
+        if self.label_degree < 0:
+            raise EigenModelError(f"label_degree must be 0 or more, got {self.label_degree}")
+
+
+@dataclass(frozen=True)
+class EigenGaitModel:
+    """Everything needed to synthesise; arrays are saved as they are in the ``.npz``."""
+
+    basis_kind: str
+    n_basis: int
+    samples: int
+    periodic: bool
+    roughness: float
+    pose_mean: np.ndarray  # (6,) rad
+    pose_axes: np.ndarray  # (6, d) U of eq. 1
+    pose_eigenvalues: np.ndarray  # (6,) all pose PCA eigenvalues (rad^2)
+    coef_mean: np.ndarray  # (d, K) mean function's coefficients per reduced channel
+    eigen_coefs: np.ndarray  # (M, d, K) every eigen-motion with a nonzero eigenvalue
+    eigenvalues: np.ndarray  # (M,)
+    n_components: int  # m', the eigen-motions kept
+    scores: np.ndarray  # (N, M) examples' coefficients
+    labels: np.ndarray  # (N,) step length of each example, metres
+    warp_coefs: np.ndarray  # (N, K) h(s) - s of each example (the DTW warp)
+    durations_s: np.ndarray  # (N,)
+    right_strike_phases: np.ndarray  # (N,) in real (unwarped) cycle phase
+    label_degree: int
+    geometry: LegGeometry
+    rate_hz: float
+    sources: tuple = field(default_factory=tuple)
+
+    # -- basic evaluation -------------------------------------------------------------------
+    @property
+    def basis(self):
+        return make_basis(self.basis_kind, self.n_basis)
+
+    @property
+    def variance_explained(self) -> np.ndarray:
+        return self.eigenvalues / self.eigenvalues.sum()
+
+    @property
+    def pose_dims(self) -> int:
+        return self.pose_axes.shape[1]
+
+    def reduced(self, s, alpha) -> np.ndarray:
+        """Reduced motion (n, d) at phases s for coefficients alpha (first len(alpha) eigen-motions)."""
+        alpha = np.asarray(alpha, dtype=float)
+        coefs = self.coef_mean + np.tensordot(alpha, self.eigen_coefs[:len(alpha)], axes=1)
+        return self.basis.evaluate(s) @ coefs.T
+
+    def poses(self, s, alpha) -> np.ndarray:
+        """Joint angles (n, 6) in radians at aligned phases s (eq. 12 then eq. 14)."""
+        return self.pose_mean + self.reduced(s, alpha) @ self.pose_axes.T
+
+    def eigen_motion(self, s, i: int) -> np.ndarray:
+        """xi_i(s) back in joint space without the mean: (n, 6) radians per unit coefficient."""
+        return (self.basis.evaluate(s) @ self.eigen_coefs[i].T) @ self.pose_axes.T
+
+    # -- labels ------------------------------------------------------------------------------
+    def _regress(self, values: np.ndarray, label: float) -> np.ndarray:
+        degree = min(self.label_degree, len(np.unique(self.labels)) - 1)
+        centre, scale = self.labels.mean(), max(np.ptp(self.labels), 1e-12)
+        x = (self.labels - centre) / scale
+        design = np.vander(x, degree + 1)
+        coef, *_ = np.linalg.lstsq(design, values.reshape(len(x), -1), rcond=None)
+        row = np.vander(np.atleast_1d((label - centre) / scale), degree + 1)
+        return (row @ coef).reshape(values.shape[1:])
+
+    def label_range(self) -> tuple[float, float]:
+        return float(self.labels.min()), float(self.labels.max())
+
+    def coefficients_for(self, step_length_m: float, components: int | None = None) -> np.ndarray:
+        m = self.n_components if components is None else components
+        return self._regress(self.scores[:, :m], step_length_m)
+
+    def timing_for(self, step_length_m: float):
+        """(duration_s, warp coefficients, right-strike phase) at a label."""
+        return (float(self._regress(self.durations_s, step_length_m)), self._regress(self.warp_coefs, step_length_m),
+                float(self._regress(self.right_strike_phases, step_length_m)))
+
+    def warp(self, s, warp_coefs) -> np.ndarray:
+        """Real cycle phase h(s) of aligned phase s."""
+        s = np.asarray(s, dtype=float)
+        return s + self.basis.evaluate(s) @ warp_coefs
+
+    def aligned_phase(self, phase, warp_coefs) -> np.ndarray:
+        """Inverse warp: aligned phase s of real cycle phase (monotone interpolation on a fine grid)."""
+        grid = np.linspace(0.0, 1.0, 20 * self.samples + 1)
+        h = np.maximum.accumulate(self.warp(grid, warp_coefs))
+        h = (h - h[0]) / (h[-1] - h[0])
+        return np.interp(phase, h, grid)
+
+    # -- pose constraint (eq. 13) -------------------------------------------------------------
+    def through_pose(self, pose_rad, s_prime: float, alpha0) -> tuple[np.ndarray, np.ndarray]:
+        """Coefficients whose motion passes through ``pose_rad`` (6,) at aligned phase s', nearest alpha0.
+
+        Returns (alpha, miss_rad (6,)): the joint-space difference left (the part of the pose outside
+        what the model's pose axes and eigen-motions can reach at s')."""
+        alpha0 = np.asarray(alpha0, dtype=float)
+        m = len(alpha0)
+        p = (np.asarray(pose_rad, dtype=float) - self.pose_mean) @ self.pose_axes
+        phi = self.basis.evaluate([s_prime])[0]
+        delta = np.stack([self.eigen_coefs[i] @ phi for i in range(m)], axis=1)  # (d, m)
+        residual = p - self.reduced([s_prime], alpha0)[0]
+        alpha = alpha0 + np.linalg.pinv(delta) @ residual
+        miss = np.asarray(pose_rad) - self.poses([s_prime], alpha)[0]
+        return alpha, miss
+
+    # -- file --------------------------------------------------------------------------------
+    def save(self, path: str | Path) -> None:
+        g = self.geometry
+        np.savez(Path(path), kind=np.array(MODEL_KIND), version=np.array(MODEL_VERSION),
+                 basis_kind=np.array(self.basis_kind), n_basis=self.n_basis, samples=self.samples,
+                 periodic=self.periodic, roughness=self.roughness, pose_mean=self.pose_mean,
+                 pose_axes=self.pose_axes, pose_eigenvalues=self.pose_eigenvalues, coef_mean=self.coef_mean,
+                 eigen_coefs=self.eigen_coefs, eigenvalues=self.eigenvalues, n_components=self.n_components,
+                 scores=self.scores, labels=self.labels, warp_coefs=self.warp_coefs, durations_s=self.durations_s,
+                 right_strike_phases=self.right_strike_phases, label_degree=self.label_degree,
+                 geometry=np.array([g.thigh, g.shank, g.foot, g.hip_width, g.ankle_height, g.heel_back]),
+                 rate_hz=self.rate_hz, sources=np.array([str(s) for s in self.sources], dtype=str))
+
+    @classmethod
+    def load(cls, path: str | Path) -> "EigenGaitModel":
+        path = Path(path)
+        if not path.is_file():
+            raise EigenModelError(f"{path}: no such file")
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                if "kind" not in z.files or str(z["kind"]) != MODEL_KIND:
+                    raise EigenModelError(f"{path}: not an eigen-gait model (made by `gaitbot eigen fit`)")
+                d = {k: z[k] for k in z.files}
+        except EigenModelError:
+            raise
+        except Exception as exc:
+            raise EigenModelError(f"{path}: not a readable eigen-gait model ({type(exc).__name__}: {exc})") from None
+        if int(d["version"]) != MODEL_VERSION:
+            raise EigenModelError(f"{path}: model version {int(d['version'])}, this gaitbot reads {MODEL_VERSION}")
+        g = d["geometry"]
+        return cls(str(d["basis_kind"]), int(d["n_basis"]), int(d["samples"]), bool(d["periodic"]),
+                   float(d["roughness"]), d["pose_mean"], d["pose_axes"], d["pose_eigenvalues"], d["coef_mean"],
+                   d["eigen_coefs"], d["eigenvalues"], int(d["n_components"]), d["scores"], d["labels"],
+                   d["warp_coefs"], d["durations_s"], d["right_strike_phases"], int(d["label_degree"]),
+                   LegGeometry(*map(float, g)), float(d["rate_hz"]), tuple(str(s) for s in d["sources"]))
+
+
+def is_model_file(path: str | Path) -> bool:
+    """True for an ``.npz`` written by ``EigenGaitModel.save`` (plot dispatches on this)."""
+    try:
+        with np.load(Path(path), allow_pickle=False) as z:
+            return "kind" in z.files and str(z["kind"]) == MODEL_KIND
+    except Exception:
+        return False
+
+
+def _leading(eigenvalues: np.ndarray, share: float) -> int:
+    """Smallest count whose eigenvalues hold more than ``share`` of the total (eq. 11)."""
+    total = eigenvalues.sum()
+    if total <= 0:
+        return 1
+    cumulative = np.cumsum(eigenvalues) / total
+    return int(min(len(eigenvalues), np.searchsorted(cumulative, share - 1e-12, side="right") + 1))
+
+
+def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: float,
+              options: FitOptions = FitOptions(), periodic: bool = True) -> EigenGaitModel:
+    """Seed 004 sections 3 and 4 on example cycles (see the module docstring)."""
+    n = len(examples)
+    if n < 2:
+        raise EigenModelError(f"functional PCA needs at least 2 example cycles, got {n}")
+    if options.components is not None and not (1 <= options.components <= n - 1):
+        raise EigenModelError(f"{options.components} eigen-motions requested, but {n} example cycles give at most "
+                              f"{n - 1}; add examples or ask for fewer components")
+    labels = np.array([e.step_length_m for e in examples])
+    distinct = len(np.unique(np.round(labels, 9)))
+    if distinct < 2:
+        raise EigenModelError(f"the examples have {distinct} distinct step length(s); the label regression needs "
+                              f"at least 2 (walks at different step lengths)")
+    phases = sample_phases(options.samples, periodic)
+    cycles = [resample_cycle(e.angles_rad, options.samples, periodic) for e in examples]
+    reference = cycles[int(np.argsort(labels)[n // 2])]
+    aligned, warps = [], []
+    for c in cycles:
+        if options.align == "dtw":
+            a, h = align_to_reference(reference, c, options.dtw_band, periodic)
+        else:
+            a, h = c, phases.copy()
+        aligned.append(a)
+        warps.append(h)
+    aligned = np.array(aligned)  # (N, S, 6)
+
+    # pose PCA (eq. 1)
+    flat = aligned.reshape(-1, aligned.shape[-1])
+    pose_mean = flat.mean(axis=0)
+    pose_eig, pose_vec = np.linalg.eigh(np.cov((flat - pose_mean).T, bias=True))
+    order = np.argsort(pose_eig)[::-1]
+    pose_eig, pose_vec = np.clip(pose_eig[order], 0.0, None), pose_vec[:, order]
+    d = _leading(pose_eig, options.pose_variance)
+    axes = pose_vec[:, :d]
+    reduced = (aligned - pose_mean) @ axes  # (N, S, d)
+
+    # functional representation (eq. 3, with the roughness penalty)
+    basis = make_basis(options.basis, options.n_basis)
+    coefs = np.array([fit_coefficients(basis, phases, r, options.roughness).T for r in reduced])  # (N, d, K)
+    warp_coefs = np.array([fit_coefficients(basis, phases, h - phases, options.roughness) for h in warps])
+
+    # functional PCA (eq. 10)
+    K = basis.n_basis
+    gram = np.kron(np.eye(d), basis.gram())
+    chol = np.linalg.cholesky(gram)
+    coef_mean = coefs.mean(axis=0)
+    centred = (coefs - coef_mean).reshape(n, d * K)
+    _, sing, vt = np.linalg.svd(centred @ chol, full_matrices=False)
+    eigenvalues = sing**2 / n
+    keep = eigenvalues > eigenvalues[0] * 1e-12 if eigenvalues[0] > 0 else np.zeros_like(eigenvalues, bool)
+    if not keep.any():
+        raise EigenModelError("the example cycles are all the same: nothing varies, no eigen-motion to find")
+    b = np.linalg.solve(chol.T, vt[keep].T).T  # (M, dK)
+    eigenvalues = eigenvalues[keep]
+    scores = centred @ gram @ b.T  # (N, M)
+    if options.components is not None:
+        if options.components > len(eigenvalues):
+            raise EigenModelError(f"{options.components} eigen-motions requested, but the {n} example cycles vary "
+                                  f"in only {len(eigenvalues)} independent ways")
+        m = options.components
+    else:
+        m = _leading(eigenvalues, options.motion_variance)
+    return EigenGaitModel(options.basis, K, options.samples, periodic, options.roughness, pose_mean, axes, pose_eig,
+                          coef_mean, b.reshape(-1, d, K), eigenvalues, m, scores, labels, warp_coefs,
+                          np.array([e.duration_s for e in examples]),
+                          np.array([e.right_strike_phase for e in examples]), options.label_degree, geometry,
+                          float(rate_hz), tuple(sorted({e.source for e in examples})))

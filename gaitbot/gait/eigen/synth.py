@@ -1,0 +1,211 @@
+"""From eigen-gait coefficients to a walk: cycles in real time, joined to a start and a stop, and the
+root from foot contact (seed 004 section 6; gait-model.md section 3).
+
+Choices (stated once):
+- The model only knows steady cycles (left heel strike to left heel strike). A walk therefore
+  starts and ends as the walker's do: the walker (seed 000, Algorithm 2) takes the robot from
+  standing through its first step to the first left heel strike; the synthesised cycles follow;
+  the walker's closing step, settle and stand end it. Joint angles and velocities are made
+  continuous at both joins by a quintic correction that fades over ``blend_cycles`` of a cycle
+  (the correction is the difference between the walker's and the model's pose and velocity at
+  the join, so it is small when the model is accurate).
+- Transitions: the label (or the coefficients) is interpolated linearly from cycle to cycle, and
+  within a cycle the coefficients go linearly from the cycle's start value to its end value, so
+  the motion is continuous (seed 004 section 7, Figs. 8 and 9).
+- Root: the contact model of the walker (contact.py): the stance foot rolls without slip about its
+  lowest sole point, the root follows it in closed form (``grounded_ankle`` minus the ankle in the
+  body frame, as segments.root_of). The stance foot is the one whose lowest sole point is lower;
+  it stays locked while it supports, and the other foot takes over only once it is lower by more
+  than ``switch_tol`` (so two feet both on the ground do not flicker). At a switch the new stance
+  foot's anchor is taken from where it is, so the root never jumps in x.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..contact import ankle_in_body, grounded_ankle, leg_pitch
+from ..geometry import LegGeometry, leg_points
+from ..trajectory import HeelStrike, Trajectory
+from .examples import CONTACT_TOL_FRACTION, foot_heights_in_body
+from .model import EigenGaitModel, EigenModelError
+
+
+def cycle_frames(model: EigenGaitModel, label_start: float, label_end: float, alpha_start, alpha_end, rate_hz: float):
+    """One cycle at the frame rate: (angles (n, 6), right-strike frame index)."""
+    duration, warp, right_phase = model.timing_for(0.5 * (label_start + label_end))
+    n = max(8, int(round(duration * rate_hz)))
+    phase = np.arange(n) / n
+    s = model.aligned_phase(phase, warp)
+    alpha_start, alpha_end = np.asarray(alpha_start, float), np.asarray(alpha_end, float)
+    angles = np.array([model.poses([si], alpha_start + si * (alpha_end - alpha_start))[0] for si in s]) \
+        if np.any(alpha_start != alpha_end) else model.poses(s, alpha_start)
+    return angles, int(round(right_phase * n))
+
+
+def synthesize_cycles(model: EigenGaitModel, cycle_labels, rate_hz: float | None = None, components=None,
+                      alphas=None):
+    """Angles of consecutive cycles. ``cycle_labels``: labels at the n+1 cycle boundaries.
+
+    ``alphas`` (n+1, m) overrides the coefficients at the boundaries (direct or pose synthesis).
+    Returns (angles (N, 6), list of cycle start frames (n+1 with the end), list of right-strike frames).
+    """
+    rate = model.rate_hz if rate_hz is None else rate_hz
+    labels = list(cycle_labels)
+    if alphas is None:
+        alphas = [model.coefficients_for(label, components) for label in labels]
+    chunks, starts, rights = [], [0], []
+    for i in range(len(labels) - 1):
+        angles, right = cycle_frames(model, labels[i], labels[i + 1], alphas[i], alphas[i + 1], rate)
+        rights.append(starts[-1] + right)
+        chunks.append(angles)
+        starts.append(starts[-1] + len(angles))
+    return np.vstack(chunks), starts, rights
+
+
+def _quintic_fade(x, p0, v0):
+    """Starts at p0 with slope v0 (per unit x), reaches 0 with zero slope and curvature at x = 1."""
+    x = np.clip(np.asarray(x, float), 0.0, 1.0)[:, None]
+    # basis: h0 (value 1, slope 0), h1 (value 0, slope 1), both with zero value/slope/curvature at 1
+    h0 = 1 - 10 * x**3 + 15 * x**4 - 6 * x**5
+    h1 = x - 6 * x**3 + 8 * x**4 - 3 * x**5
+    return h0 * p0 + h1 * v0
+
+
+def join_smoothly(head: np.ndarray, body: np.ndarray, tail: np.ndarray, fade_frames: int) -> np.ndarray:
+    """head + body + tail, body corrected so angles and velocities are continuous at both joins.
+
+    ``head`` ends with the frame just before the body's first; ``tail`` starts with the frame after
+    the body's last. The correction fades over ``fade_frames`` at each end of the body."""
+    body = body.copy()
+    n = len(body)
+    fade = max(2, min(fade_frames, n // 2))
+    x = np.arange(n) / fade
+    # at the start: the body's frame 0 should continue the head
+    want0 = 2 * head[-1] - head[-2]
+    got_v0 = body[1] - body[0]
+    want_v0 = head[-1] - head[-2]
+    body += _quintic_fade(x, want0 - body[0], (want_v0 - got_v0) * fade)
+    # at the end: the body's last frame should lead into the tail
+    xe = (n - 1 - np.arange(n)) / fade
+    want_end = 2 * tail[0] - tail[1]
+    got_ve = body[-1] - body[-2]
+    want_ve = tail[1] - tail[0]
+    body += _quintic_fade(xe, want_end - body[-1], -(want_ve - got_ve) * fade)
+    return np.vstack([head, body, tail])
+
+
+def root_from_contact(geometry: LegGeometry, angles_rad: np.ndarray, start_root, land_tol: float | None = None):
+    """Root (N, 2) keeping the supporting foot still (see the module docstring), and the stance leg per frame.
+
+    The other foot takes over once it is lower than the stance foot by more than ``land_tol``
+    (metres; default a quarter of CONTACT_TOL_FRACTION of the leg): with both feet on the ground
+    the stance foot stays locked until it lifts.
+    """
+    tol = 0.25 * CONTACT_TOL_FRACTION * geometry.leg_length if land_tol is None else land_tol
+    heights = foot_heights_in_body(geometry, angles_rad)
+    legs = [angles_rad[:, 0:3], angles_rad[:, 3:6]]
+    pitch = [leg_pitch(q) for q in legs]
+    ankle = [ankle_in_body(geometry, q) for q in legs]
+    n = len(angles_rad)
+    root = np.empty((n, 2))
+    stance = np.empty(n, dtype=int)
+    current = int(np.argmin(heights[0]))
+
+    def anchor_for(leg: int, k: int, root_k) -> float:
+        # grounded_ankle is x-linear in the anchor with unit slope: invert it at this frame
+        world_ankle_x = root_k[0] + ankle[leg][k, 0]
+        return float(world_ankle_x - grounded_ankle(geometry, 0.0, pitch[leg][k])[0])
+
+    anchor = anchor_for(current, 0, np.asarray(start_root, float))
+    for k in range(n):
+        other = 1 - current
+        if k > 0 and heights[k, other] < heights[k, current] - tol:
+            anchor = anchor_for(other, k, root[k - 1])
+            current = other
+        root[k] = grounded_ankle(geometry, anchor, pitch[current][k]) - ankle[current][k]
+        stance[k] = current
+    return root, stance
+
+
+def heel_x(geometry: LegGeometry, angles_rad, root, frame: int, leg: str) -> float:
+    side = 0 if leg == "left" else 1
+    q = angles_rad[frame, 3 * side:3 * side + 3]
+    _, _, heel, _ = leg_points(geometry, q[0], q[1], q[2])
+    return float(heel[0] + root[frame, 0])
+
+
+def check_labels(model: EigenGaitModel, labels, extrapolate: float = 0.0) -> None:
+    lo, hi = model.label_range()
+    span = hi - lo
+    for label in labels:
+        if not np.isfinite(label) or label < lo - extrapolate * span - 1e-12 or label > hi + extrapolate * span + 1e-12:
+            raise EigenModelError(f"step length {label:g} m is outside the examples' range {lo:.4g} to {hi:.4g} m "
+                                  f"(the label regression is only trusted between the examples)")
+
+
+def assemble_walk(model: EigenGaitModel, head: Trajectory, body: np.ndarray, body_rights, body_cycle_starts,
+                  tail: Trajectory, blend_frames: int) -> Trajectory:
+    """Head (walker, ends just before a left heel strike) + body cycles + tail (walker, from a left heel strike)."""
+    g = model.geometry
+    angles = join_smoothly(head.angles_rad, body, tail.angles_rad, blend_frames)
+    rate = model.rate_hz
+    t = np.arange(len(angles)) / rate
+    root, _ = root_from_contact(g, angles, head.root_m[0])
+    offset = len(head)
+    events = [(int(round((h.t_s - head.t_s[0]) * rate)), h.leg) for h in head.heel_strikes
+              if h.t_s < head.t_s[-1] + 0.5 / rate]
+    events += [(offset + k, "left") for k in body_cycle_starts] + [(offset + k, "right") for k in body_rights]
+    strikes = []
+    tail_offset = offset + len(body)
+    events += [(tail_offset + int(round((h.t_s - tail.t_s[0]) * rate)), h.leg) for h in tail.heel_strikes]
+    for frame, leg in sorted(events):
+        frame = min(frame, len(t) - 1)
+        strikes.append(HeelStrike(float(t[frame]), leg, heel_x(g, angles, root, frame, leg)))
+    return Trajectory(t, angles, root, tuple(strikes))
+
+
+def _walker_part(geometry, settings, step_m: float, n_steps: int):
+    from ..walker import plan_walk, trajectory_of
+
+    return trajectory_of(plan_walk(geometry, [step_m] * n_steps, settings))
+
+
+def _frame(trajectory: Trajectory, t_s: float) -> int:
+    return int(np.argmin(np.abs(trajectory.t_s - t_s)))
+
+
+def synthesize_walk(model: EigenGaitModel, settings, step_start_m: float, step_end_m: float | None = None,
+                    cycles: int = 3, components: int | None = None, alphas=None,
+                    blend_cycles: float = 0.25) -> Trajectory:
+    """A whole walk: the walker's start (two steps at ``step_start_m``), ``cycles`` synthesised cycles
+    (labels going linearly from ``step_start_m`` to ``step_end_m``), the walker's closing step and stand.
+
+    ``alphas`` (cycles + 1, m): coefficients at the cycle boundaries instead of the label regression
+    (the labels then only choose the timing and the walker's start and stop).
+    ``settings``: the walker's WalkSettings; its rate must be the model's.
+    """
+    if cycles < 1:
+        raise EigenModelError(f"--cycles must be 1 or more, got {cycles}")
+    end = step_start_m if step_end_m is None else step_end_m
+    check_labels(model, [step_start_m, end])
+    if abs(settings.rate_hz - model.rate_hz) > 1e-9:
+        raise EigenModelError(f"the robot's frame rate {settings.rate_hz:g} Hz is not the model's {model.rate_hz:g} Hz")
+    labels = list(np.linspace(step_start_m, end, cycles + 1))
+    body, starts, rights = synthesize_cycles(model, labels, components=components, alphas=alphas)
+    first = _walker_part(model.geometry, settings, step_start_m, 2)
+    k_head = _frame(first, [h for h in first.heel_strikes if h.leg == "left"][0].t_s)
+    head = Trajectory(first.t_s[:k_head], first.angles_rad[:k_head], first.root_m[:k_head],
+                      tuple(h for h in first.heel_strikes if h.t_s < first.t_s[k_head] - 0.5 / model.rate_hz))
+    last = _walker_part(model.geometry, settings, end, 2)
+    lefts = [h for h in last.heel_strikes if h.leg == "left"]
+    k_tail = _frame(last, lefts[-1].t_s)
+    tail = Trajectory(last.t_s[k_tail + 1:], last.angles_rad[k_tail + 1:], last.root_m[k_tail + 1:],
+                      tuple(h for h in last.heel_strikes if h.t_s > last.t_s[k_tail] + 0.5 / model.rate_hz))
+    # the body's last cycle ends just before a left heel strike; the tail's first frame is just after
+    # it, so the strike frame itself is the model's (its phase 1 = phase 0 of the next cycle)
+    strike_pose = model.poses([0.0], alphas[-1] if alphas is not None else model.coefficients_for(end, components))
+    body = np.vstack([body, strike_pose])
+    starts = list(starts)
+    fade = int(round(blend_cycles * len(body) / cycles))
+    return assemble_walk(model, head, body, rights, starts, tail, fade)
