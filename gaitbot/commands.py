@@ -9,10 +9,11 @@ from pathlib import Path
 
 from gaitbot.bus.budget import check_rate
 from gaitbot.bus.factory import make_bus
+from gaitbot.bus.guard import LimitGuard
 from gaitbot.bus.recording import BusRecorder
 from gaitbot.clock import MonotonicClock, VirtualClock
 from gaitbot.gait.trajectory import Trajectory
-from gaitbot.robot.calibration import angles_to_ticks, standing_ticks
+from gaitbot.robot.calibration import angles_to_ticks, standing_ticks, tick_limits
 from gaitbot.session import (UsageError, gait_source, joint_limits_ticks, load_robot, plan_summary, preflight,
                              trajectory_for_robot)
 from gaitbot.stream import latency_timer_warning, walk_session
@@ -130,6 +131,7 @@ def cmd_walk(args) -> int:
         recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now)
     bus = make_bus(config.bus.backend, config.bus.protocol, port, config.bus.baudrate, config.models_by_id,
                    dry_run=args.dry_run, recorder=recorder)
+    bus = LimitGuard(bus, tick_limits(config), {j.id: j.name for j in config.joints})
     velocity, acceleration = joint_limits_ticks(config)
     try:
         result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,

@@ -89,3 +89,13 @@ def ticks_to_angles(config: "RobotConfig", ticks) -> np.ndarray:
 def standing_ticks(config: "RobotConfig") -> np.ndarray:
     """Ticks of the standing pose: every walking joint at 0 rad, held joints at hold_deg. Shape (n_joints,)."""
     return angles_to_ticks(config, np.zeros(N_WALKING))
+
+
+def tick_limits(config: "RobotConfig") -> dict[int, tuple[int, int]]:
+    """Per servo id, the lowest and highest tick its joint's min_deg/max_deg round to.
+
+    Rounding is monotone, so every angle inside [min_deg, max_deg] becomes a tick inside these."""
+    zero, direction, per_rad = joint_parameters(config)
+    lo = angle_rad_to_ticks(np.radians([j.min_deg for j in config.joints]), zero, direction, per_rad)
+    hi = angle_rad_to_ticks(np.radians([j.max_deg for j in config.joints]), zero, direction, per_rad)
+    return {j.id: (int(min(a, b)), int(max(a, b))) for j, a, b in zip(config.joints, lo, hi)}
