@@ -25,6 +25,8 @@ def _walk_inputs(p: argparse.ArgumentParser) -> None:
     p.add_argument("--foot", type=float, help="foot length in metres")
     p.add_argument("--clearance", type=float, help="swing-foot clearance in metres (default: the robot's)")
     p.add_argument("--rate", type=float, help="frame rate in Hz (default: the robot's rate_hz)")
+    p.add_argument("--terrain", metavar="FILE", help="walk a terrain course (TOML, see config/terrain/) instead of "
+                   "--steps/--distance")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -49,6 +51,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--shank", type=float)
     p.add_argument("--foot", type=float)
     p.add_argument("--clearance", type=float)
+    p.add_argument("--terrain", metavar="FILE", help="terrain course the trajectory walked: draw it")
 
     p = sub.add_parser("walk", help="walk the robot (or a dry run on the mock bus)")
     _walk_inputs(p)
@@ -102,7 +105,11 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.command in ("plan", "generate", "walk") and args.steps is None and args.distance is None:
+    if args.command in ("plan", "generate", "walk") and getattr(args, "terrain", None) is not None and (
+            args.steps is not None or args.distance is not None):
+        parser.error(f"{args.command}: give --terrain or --steps/--distance, not both")
+    if (args.command in ("plan", "generate", "walk") and args.steps is None and args.distance is None
+            and getattr(args, "terrain", None) is None):
         if args.command == "walk" and args.dry_run:
             args.distance = 0.5  # the built-in demo: half a metre on the mock bus
         else:

@@ -19,7 +19,34 @@ from gaitbot.session import (UsageError, gait_source, joint_limits_ticks, load_r
 from gaitbot.stream import latency_timer_warning, walk_session
 
 
+def _plan_terrain(args) -> int:
+    from gaitbot.session import terrain_plan_summary
+
+    source, walk, _ = trajectory_for_robot(args)
+    plan = terrain_plan_summary(source, walk)
+    if args.json:
+        print(json.dumps(plan, indent=2))
+        return 0
+    print(f"{'step':>4} {'leg':>5} {'length m':>9} {'start s':>8} {'end s':>7} {'foothold m':>10} {'height m':>8} "
+          f"{'method':>8} {'lift m':>7}")
+    for s in plan["steps"]:
+        label = "close" if s["closing"] else str(s["index"])
+        print(f"{label:>4} {s['leg']:>5} {s['length_m']:9.4f} {s['start_s']:8.3f} {s['end_s']:7.3f} "
+              f"{s['foothold_m']:10.4f} {s['height_m']:8.4f} {s['method']:>8} {s['lift_m']:7.4f}")
+    for i, r in enumerate(plan["searches"], start=1):
+        centre = f"{r['centre_cost']:.4g}" if r["centre_cost"] is not None else "unreachable"
+        print(f"MDS {i}: pelvis at ({r['mds_m'][0]:.4f}, {r['mds_m'][1]:.4f}) m, cost {r['cost']:.4g} "
+              f"(middle of the region: {centre}); {r['evaluated']} cells scored, {r['pruned']} skipped as "
+              f"unreachable, of {r['full_grid']} in a full search")
+    print(f"{plan['n_steps']} steps ({plan['n_terrain_steps']} on terrain), {plan['duration_s']:.2f} s, "
+          f"{plan['n_frames']} frames; grid search scored {plan['cells_evaluated']} cells against "
+          f"{plan['cells_full_search']} for full searches")
+    return 0
+
+
 def cmd_plan(args) -> int:
+    if getattr(args, "terrain", None) is not None:
+        return _plan_terrain(args)
     source, walker, _ = trajectory_for_robot(args)
     plan = plan_summary(source, walker)
     if args.json:
@@ -66,7 +93,13 @@ def cmd_plot(args) -> int:
     trajectory = Trajectory.load(args.file)
     source = gait_source(args)
     out = Path(args.output)
-    plot_trajectory(trajectory, source.geometry, out, clearance=source.settings.clearance, title=Path(args.file).name)
+    terrain = None
+    if getattr(args, "terrain", None) is not None:
+        from gaitbot.terrain_file import load_course
+
+        terrain = load_course(args.terrain).terrain
+    plot_trajectory(trajectory, source.geometry, out, clearance=source.settings.clearance, title=Path(args.file).name,
+                    terrain=terrain)
     print(f"wrote {out}")
     return 0
 

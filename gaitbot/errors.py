@@ -7,6 +7,7 @@ from gaitbot.gait.step_length import StepLengthError
 from gaitbot.gait.trajectory import TrajectoryFileError
 from gaitbot.robot.config import ConfigError
 from gaitbot.session import UsageError
+from gaitbot.terrain_file import TerrainFileError
 
 USER_ERRORS = (UsageError, ConfigError, StepLengthError, TrajectoryFileError, RecordingError, GaitGenerationError,
-               EigenModelError, ExampleError)
+               EigenModelError, ExampleError, TerrainFileError)

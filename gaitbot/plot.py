@@ -25,7 +25,9 @@ def _world_points(geometry: LegGeometry, trajectory: Trajectory, side: int):
 
 
 def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, clearance: float = 0.0,
-                    title: str = "") -> None:
+                    title: str = "", terrain=None) -> None:
+    """``terrain`` (a gaitbot.gait.terrain.model.Terrain), when given, is drawn under the walk; foot heights
+    are then measured from the terrain under each foot and footholds sit on their treads."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -51,6 +53,10 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
 
     for side, name in ((0, "left"), (1, "right")):
         _, _, _, heel, toe = _world_points(geometry, trajectory, side)
+        if terrain is not None:
+            low = np.minimum(heel[:, 1] - terrain.height_at(heel[:, 0]), toe[:, 1] - terrain.height_at(toe[:, 0]))
+            ax_feet.plot(t, 1000 * low, color=_COLOURS[name], label=f"{name} foot lowest point above the terrain")
+            continue
         ax_feet.plot(t, 1000 * np.minimum(heel[:, 1], toe[:, 1]), color=_COLOURS[name], label=f"{name} foot lowest point")
     if clearance > 0:
         ax_feet.axhline(1000 * clearance, color="k", ls="--", lw=0.8, label=f"clearance {1000 * clearance:.0f} mm")
@@ -69,9 +75,20 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
             ys = [root[k, 1], knee[k, 1], ankle[k, 1], heel[k, 1], toe[k, 1], ankle[k, 1]]
             ax_stick.plot(xs, ys, color=_COLOURS[name], lw=1.0, alpha=0.7)
     ax_stick.plot(trajectory.root_m[:, 0], trajectory.root_m[:, 1], color="k", lw=0.8, label="hip path")
+    ground = (lambda x: float(terrain.height_at(x))) if terrain is not None else (lambda x: 0.0)  # noqa: E731
     for strike in trajectory.heel_strikes:
-        ax_stick.plot([strike.x_m], [0.0], marker="^", color=_COLOURS[strike.leg], ms=8)
-    ax_stick.axhline(0.0, color="saddlebrown", lw=1.5)
+        ax_stick.plot([strike.x_m], [ground(strike.x_m)], marker="^", color=_COLOURS[strike.leg], ms=8)
+    if terrain is None:
+        ax_stick.axhline(0.0, color="saddlebrown", lw=1.5)
+    else:
+        x0, x1 = ax_stick.get_xlim()
+        px, py = [], []
+        for surface in terrain.surfaces:
+            a, b = max(surface.start, x0), min(surface.end, x1)
+            if a < b:
+                px += [a, b]
+                py += [surface.height, surface.height]
+        ax_stick.plot(px, py, color="saddlebrown", lw=1.5, label="terrain")
     ax_stick.set_aspect("equal")
     ax_stick.set_xlabel("x (m)   poses at each heel strike and mid-step; triangles: planned footholds (blue left, red right)")
     ax_stick.set_ylabel("y (m)")

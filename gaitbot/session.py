@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from gaitbot.bus.budget import check_rate
 from gaitbot.check import CheckReport, check_trajectory, trajectory_angles_deg
 from gaitbot.gait.geometry import LegGeometry
+from gaitbot.gait.segments import GaitGenerationError
 from gaitbot.gait.planning import perturb_steps, steps_for_distance
 from gaitbot.gait.step_length import StepLengthError
 from gaitbot.gait.trajectory import Trajectory
@@ -171,5 +172,69 @@ def joint_limits_ticks(config: RobotConfig) -> tuple[float, float]:
 
 
 def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:
+    if getattr(args, "terrain", None) is not None:
+        source, walk = build_terrain_walk(args)
+        return source, walk, walk.trajectory
     source, walker = build_walk(args)
     return source, walker, trajectory_of(walker)
+
+
+def terrain_settings(source: GaitSource, course, clearance_override: float | None = None):
+    """How to walk a course: the file's values, else the robot's (clearance, joint ranges), else defaults
+    in leg lengths (longest step onto another surface 0.75, rise 0.25; seed 000 Table 3's reach)."""
+    from gaitbot.gait.terrain.walk import TerrainSettings, default_weights
+
+    leg = source.geometry.leg_length
+    lo = hi = None
+    if source.robot is not None:
+        lo = tuple(math.radians(j.min_deg) for j in source.robot.joints[:3])
+        hi = tuple(math.radians(j.max_deg) for j in source.robot.joints[:3])
+    clearance = course.clearance_m if course.clearance_m is not None else source.settings.clearance
+    if clearance_override is not None:
+        clearance = clearance_override
+    max_step = course.max_step_m if course.max_step_m is not None else 0.75 * leg
+    return TerrainSettings(margin=course.margin_m, clearance=clearance, max_step=max_step,
+                           max_rise=course.max_rise_m if course.max_rise_m is not None else 0.25 * leg,
+                           max_travel=max_step, weights=course.weights or default_weights(lo, hi),
+                           joint_lo=lo, joint_hi=hi)
+
+
+def build_terrain_walk(args):
+    """Footholds, pelvis search and trajectory for ``--terrain FILE`` (seed 003 joined to the flat walker)."""
+    from gaitbot.gait.terrain.footholds import CourseError
+    from gaitbot.gait.terrain.walk import plan_terrain_walk
+    from gaitbot.terrain_file import load_course
+
+    source = gait_source(args)
+    course = load_course(args.terrain)
+    settings = terrain_settings(source, course, getattr(args, "clearance", None))
+    try:
+        walk = plan_terrain_walk(make_context(source.geometry, source.settings), course.terrain, course.start_m,
+                                 course.end_m, settings, source.max_step_m)
+    except CourseError as exc:
+        raise UsageError(f"{course.path}: {exc}") from None
+    except GaitGenerationError as exc:
+        raise GaitGenerationError(f"{course.path}: {exc}") from None
+    return source, walk
+
+
+def terrain_plan_summary(source: GaitSource, walk) -> dict:
+    """A terrain plan as a JSON-ready object: steps with their method, footholds, and the grid searches."""
+    searches = [{"mds_m": list(r.point), "cost": r.cost, "centre_cost": r.centre_cost if math.isfinite(r.centre_cost)
+                 else None, "evaluated": r.evaluated, "pruned": r.pruned, "full_grid": r.full_grid}
+                for r in walk.search_reports]
+    traj = walk.trajectory
+    return {
+        "robot": source.robot.name if source.robot is not None else None,
+        "leg_length_m": source.geometry.leg_length,
+        "rate_hz": walk.ctx.rate_hz,
+        "steps": [s.to_dict() for s in walk.steps],
+        "n_steps": len(walk.steps),
+        "n_terrain_steps": sum(1 for s in walk.steps if s.method == "terrain"),
+        "searches": searches,
+        "cells_evaluated": sum(r.evaluated for r in walk.search_reports),
+        "cells_full_search": sum(r.full_grid for r in walk.search_reports),
+        "duration_s": float(traj.t_s[-1]),
+        "n_frames": len(traj),
+        "total_distance_m": walk.steps[-1].foothold_m - (walk.steps[0].foothold_m - walk.steps[0].length_m),
+    }
