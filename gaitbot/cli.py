@@ -59,6 +59,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--realtime", action="store_true", help="pace a dry run at the real frame rate")
     p.add_argument("--record", help="write every bus packet to this .jsonl file")
     p.add_argument("--port", help="serial port (default: the robot config's)")
+    p.add_argument("--reply-timeout-ms", type=float,
+                   help="how long to wait for each status packet (default: the SDK's, about 34 ms at 1 Mbaud)")
 
     p = sub.add_parser("check", help="check a trajectory or a recorded run against the robot's limits")
     p.add_argument("file", help="trajectory (.csv, .npz) or bus recording (.jsonl)")

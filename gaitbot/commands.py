@@ -162,8 +162,10 @@ def cmd_walk(args) -> int:
     if args.record:
         joints = {j.name: j.id for j in config.joints}
         recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now)
+    if args.reply_timeout_ms is not None and not (math.isfinite(args.reply_timeout_ms) and args.reply_timeout_ms > 0):
+        raise UsageError(f"--reply-timeout-ms must be a positive number of milliseconds, got {args.reply_timeout_ms!r}")
     bus = make_bus(config.bus.backend, config.bus.protocol, port, config.bus.baudrate, config.models_by_id,
-                   dry_run=args.dry_run, recorder=recorder)
+                   dry_run=args.dry_run, recorder=recorder, reply_timeout_ms=args.reply_timeout_ms)
     bus = LimitGuard(bus, tick_limits(config), {j.id: j.name for j in config.joints})
     velocity, acceleration = joint_limits_ticks(config)
     try:

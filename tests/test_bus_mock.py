@@ -68,3 +68,18 @@ def test_protocol2_status_with_ff_ff_fd_in_data_is_stuffed():
     reply = port.readPort(100)
     # INST 55, ERR 00, data FF FF FD [FD] 00: 7 payload bytes + CRC -> LEN 9
     assert reply[:14] == bytes.fromhex("FF FF FD 00 01 09 00 55 00 FF FF FD FD 00")
+
+
+def test_reply_timeout_option_replaces_the_sdk_timeout():
+    """--reply-timeout-ms: the SDK's timeout is packet bytes at the baud rate + 2 x 16 ms + 2 ms;
+    with the option it is packet bytes at the baud rate + the given milliseconds."""
+    from gaitbot.bus.factory import make_bus
+    from gaitbot.robot.servo_models import servo_model
+
+    model = servo_model("XL430-W250")
+    bus = make_bus("dynamixel", 2.0, "/dev/null-not-opened", 1_000_000, {1: model}, dry_run=False,
+                   reply_timeout_ms=250.0)
+    handler = bus.port
+    handler.tx_time_per_byte = 0.01  # ms per byte at 1 Mbaud, as setBaudRate would set it
+    handler.setPacketTimeout(10)
+    assert handler.packet_timeout == 10 * 0.01 + 250.0

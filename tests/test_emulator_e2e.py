@@ -13,7 +13,6 @@ from __future__ import annotations
 import subprocess
 import sys
 import time
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -80,18 +79,21 @@ def dry_run_ticks(config_path: Path, workdir: Path, walk_args: list[str]) -> np.
 
 @pytest.fixture(scope="module")
 def full_walks(tmp_path_factory):
-    """One 0.3 m walk per protocol (each shipped config, plus an SCS0009 biped), two at a time."""
+    """One 0.3 m walk per protocol (each shipped config, plus an SCS0009 biped), one at a time."""
     base = tmp_path_factory.mktemp("walks")
     configs = dict(CONFIGS, **{"feetech-scs": scs_config(base)})
     args = ["--distance", "0.3"]
 
     def one(protocol):
         work = base / protocol
-        result = walk_through_emulator(configs[protocol], work, args)
+        # the goals, not the timing, are under test here: a generous reply timeout keeps a busy CI
+        # host's scheduling stalls from being taken for a servo answering late (faults are tested below)
+        result = walk_through_emulator(configs[protocol], work, args + ["--reply-timeout-ms", "250"])
         return protocol, (*result, dry_run_ticks(configs[protocol], work, args))
 
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        return dict(pool.map(one, configs))
+    # one walk at a time: two walks and their emulators on a 2-core machine can delay a reply past the
+    # SDK's 34 ms timeout, which the driver (rightly) reports as a servo answering late
+    return dict(one(protocol) for protocol in configs)
 
 
 @pytest.mark.parametrize("protocol", ["dxl1", "dxl2", "feetech-sts", "feetech-scs"])
