@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from gaitbot.gait.geometry import LegGeometry, leg_points
-from gaitbot.gait.trajectory import WALKING_JOINTS, Trajectory
+from gaitbot.gait.trajectory import WALKING_JOINTS, HeelStrike, Trajectory
 
 _COLOURS = {"left": "tab:blue", "right": "tab:red"}
 
@@ -22,6 +22,30 @@ def _world_points(geometry: LegGeometry, trajectory: Trajectory, side: int):
     knee, ankle, heel, toe = leg_points(geometry, q[:, 0], q[:, 1], q[:, 2])
     root = trajectory.root_m
     return root, knee + root, ankle + root, heel + root, toe + root
+
+
+def _foot_heights(geometry: LegGeometry, trajectory: Trajectory, terrain=None) -> dict[str, np.ndarray]:
+    """Lowest sole point of each foot above the ground (or the terrain under it), metres."""
+    lows = {}
+    for side, name in ((0, "left"), (1, "right")):
+        _, _, _, heel, toe = _world_points(geometry, trajectory, side)
+        if terrain is not None:
+            lows[name] = np.minimum(heel[:, 1] - terrain.height_at(heel[:, 0]), toe[:, 1] - terrain.height_at(toe[:, 0]))
+        else:
+            lows[name] = np.minimum(heel[:, 1], toe[:, 1])
+    return lows
+
+
+def _detected_heel_strikes(geometry: LegGeometry, trajectory: Trajectory, lows) -> tuple[HeelStrike, ...]:
+    """Heel strikes of a file that carries none (CSV): a foot's lowest point reaching the ground."""
+    touch = 1e-4 * geometry.leg_length
+    strikes = []
+    for side, name in ((0, "left"), (1, "right")):
+        _, _, _, heel, _ = _world_points(geometry, trajectory, side)
+        low = lows[name]
+        for k in np.flatnonzero((low[:-1] > touch) & (low[1:] <= touch)) + 1:
+            strikes.append(HeelStrike(float(trajectory.t_s[k]), name, float(heel[k, 0])))
+    return tuple(sorted(strikes, key=lambda h: h.t_s))
 
 
 def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, clearance: float = 0.0,
@@ -34,6 +58,8 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
     import matplotlib.pyplot as plt
 
     t = trajectory.t_s
+    lows = _foot_heights(geometry, trajectory, terrain)
+    heel_strikes = trajectory.heel_strikes or _detected_heel_strikes(geometry, trajectory, lows)
     fig = plt.figure(figsize=(12, 9), constrained_layout=True)
     grid = fig.add_gridspec(3, 1, height_ratios=[1.2, 0.8, 1.0])
     ax_angles, ax_feet, ax_stick = (fig.add_subplot(grid[i]) for i in range(3))
@@ -43,7 +69,7 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
         style = {"hip": "-", "knee": "--", "ankle": ":"}[name.split("_")[0]]
         ax_angles.plot(t, np.degrees(trajectory.angles_rad[:, i]), style, color=_COLOURS[side], lw=1.2,
                        label=name.replace("_pitch", ""))
-    for strike in trajectory.heel_strikes:
+    for strike in heel_strikes:
         ax_angles.axvline(strike.t_s, color=_COLOURS[strike.leg], lw=0.5, alpha=0.4)
     ax_angles.set_ylabel("joint angle (deg, flexion +)")
     ax_angles.legend(ncol=6, fontsize=8, loc="upper center")
@@ -51,13 +77,9 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
                         f"  (vertical lines: heel strikes)")
     ax_angles.grid(alpha=0.3)
 
-    for side, name in ((0, "left"), (1, "right")):
-        _, _, _, heel, toe = _world_points(geometry, trajectory, side)
-        if terrain is not None:
-            low = np.minimum(heel[:, 1] - terrain.height_at(heel[:, 0]), toe[:, 1] - terrain.height_at(toe[:, 0]))
-            ax_feet.plot(t, 1000 * low, color=_COLOURS[name], label=f"{name} foot lowest point above the terrain")
-            continue
-        ax_feet.plot(t, 1000 * np.minimum(heel[:, 1], toe[:, 1]), color=_COLOURS[name], label=f"{name} foot lowest point")
+    for name, low in lows.items():
+        above = " above the terrain" if terrain is not None else ""
+        ax_feet.plot(t, 1000 * low, color=_COLOURS[name], label=f"{name} foot lowest point{above}")
     if clearance > 0:
         ax_feet.axhline(1000 * clearance, color="k", ls="--", lw=0.8, label=f"clearance {1000 * clearance:.0f} mm")
     ax_feet.set_ylabel("foot height (mm)")
@@ -65,7 +87,7 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
     ax_feet.legend(fontsize=8, loc="upper right")
     ax_feet.grid(alpha=0.3)
 
-    strikes = [int(round(h.t_s / (t[1] - t[0]))) for h in trajectory.heel_strikes]
+    strikes = [int(round(h.t_s / (t[1] - t[0]))) for h in heel_strikes]
     marks = [0, *strikes, len(t) - 1]
     frames = sorted({*marks, *((a + b) // 2 for a, b in zip(marks, marks[1:]))})
     for side, name in ((0, "left"), (1, "right")):
@@ -76,7 +98,7 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
             ax_stick.plot(xs, ys, color=_COLOURS[name], lw=1.0, alpha=0.7)
     ax_stick.plot(trajectory.root_m[:, 0], trajectory.root_m[:, 1], color="k", lw=0.8, label="hip path")
     ground = (lambda x: float(terrain.height_at(x))) if terrain is not None else (lambda x: 0.0)  # noqa: E731
-    for strike in trajectory.heel_strikes:
+    for strike in heel_strikes:
         ax_stick.plot([strike.x_m], [ground(strike.x_m)], marker="^", color=_COLOURS[strike.leg], ms=8)
     if terrain is None:
         ax_stick.axhline(0.0, color="saddlebrown", lw=1.5)
