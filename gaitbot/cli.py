@@ -61,6 +61,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--port", help="serial port (default: the robot config's)")
     p.add_argument("--reply-timeout-ms", type=float,
                    help="how long to wait for each status packet (default: the SDK's, about 34 ms at 1 Mbaud)")
+    p.add_argument("--trajectory", metavar="FILE", help="walk a trajectory file (.csv/.npz: gaitbot generate, "
+                   "eigen synth, record) instead of --steps/--distance; it streams at its own frame rate")
 
     p = sub.add_parser("check", help="check a trajectory or a recorded run against the robot's limits")
     p.add_argument("file", help="trajectory (.csv, .npz) or bus recording (.jsonl)")
@@ -96,6 +98,18 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--robot", help="robot config (default xl430-biped)")
     q.add_argument("-o", "--output", required=True, help="walk.csv or walk.npz")
 
+    p = sub.add_parser("record", help="record a motion made by hand: torque off, positions read to a trajectory CSV")
+    p.add_argument("--robot", help="robot config (a .toml path or a shipped name; default xl430-biped)")
+    p.add_argument("-o", "--output", required=True, help="trajectory CSV, written as it is read, e.g. demo.csv")
+    p.add_argument("--duration", type=float, help="seconds to record (default: until Ctrl-C)")
+    p.add_argument("--yes", action="store_true", help="turn torque off without asking")
+    p.add_argument("--hold", action="store_true", help="at the end, hold the last pose (torque on) instead of "
+                   "leaving torque off")
+    p.add_argument("--port", help="serial port (default: the robot config's)")
+    p.add_argument("--dry-run", action="store_true", help="record from the mock bus (needs --duration)")
+    p.add_argument("--reply-timeout-ms", type=float,
+                   help="how long to wait for each status packet (default: the SDK's, about 34 ms at 1 Mbaud)")
+
     p = sub.add_parser("scan", help="list the servos that answer")
     p.add_argument("--robot", help="robot config (default xl430-biped)")
     p.add_argument("--port", help="serial port (default: the robot config's)")
@@ -107,11 +121,10 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.command in ("plan", "generate", "walk") and getattr(args, "terrain", None) is not None and (
-            args.steps is not None or args.distance is not None):
-        parser.error(f"{args.command}: give --terrain or --steps/--distance, not both")
-    if (args.command in ("plan", "generate", "walk") and args.steps is None and args.distance is None
-            and getattr(args, "terrain", None) is None):
+    sources = [name for name in ("steps", "distance", "terrain", "trajectory") if getattr(args, name, None) is not None]
+    if args.command in ("plan", "generate", "walk") and len(sources) > 1:
+        parser.error(f"{args.command}: give one of --{' / --'.join(sources)}, not several")
+    if args.command in ("plan", "generate", "walk") and not sources:
         if args.command == "walk" and args.dry_run:
             args.distance = 0.5  # the built-in demo: half a metre on the mock bus
         else:

@@ -219,6 +219,12 @@ def cmd_check(args) -> int:
     return run_check(args)
 
 
+def cmd_record(args) -> int:
+    from gaitbot.record_command import run_record
+
+    return run_record(args)
+
+
 def cmd_eigen(args) -> int:
     from gaitbot.eigen_command import run_eigen
 

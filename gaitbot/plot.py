@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gaitbot.gait.footfall import CONTACT_TOL_FRACTION, heel_strikes_from_heights
 from gaitbot.gait.geometry import LegGeometry, leg_points
 from gaitbot.gait.trajectory import WALKING_JOINTS, HeelStrike, Trajectory
 
@@ -37,15 +38,11 @@ def _foot_heights(geometry: LegGeometry, trajectory: Trajectory, terrain=None) -
 
 
 def _detected_heel_strikes(geometry: LegGeometry, trajectory: Trajectory, lows) -> tuple[HeelStrike, ...]:
-    """Heel strikes of a file that carries none (CSV): a foot's lowest point reaching the ground."""
-    touch = 1e-4 * geometry.leg_length
-    strikes = []
-    for side, name in ((0, "left"), (1, "right")):
-        _, _, _, heel, _ = _world_points(geometry, trajectory, side)
-        low = lows[name]
-        for k in np.flatnonzero((low[:-1] > touch) & (low[1:] <= touch)) + 1:
-            strikes.append(HeelStrike(float(trajectory.t_s[k]), name, float(heel[k, 0])))
-    return tuple(sorted(strikes, key=lambda h: h.t_s))
+    """Heel strikes of a file that carries none (CSV, recordings): footfall.py's rule on the feet's
+    heights above the ground under them (the same rule ``gaitbot eigen fit`` cuts cycles with)."""
+    heel_x = np.column_stack([_world_points(geometry, trajectory, side)[3][:, 0] for side in (0, 1)])
+    heights = np.column_stack([lows["left"], lows["right"]])
+    return tuple(heel_strikes_from_heights(trajectory.t_s, heights, heel_x, CONTACT_TOL_FRACTION * geometry.leg_length))
 
 
 def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, clearance: float = 0.0,

@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from gaitbot.bus.budget import check_rate
 from gaitbot.check import CheckReport, check_trajectory, trajectory_angles_deg
 from gaitbot.gait.geometry import LegGeometry
@@ -171,7 +173,51 @@ def joint_limits_ticks(config: RobotConfig) -> tuple[float, float]:
     return vel, acc
 
 
+@dataclass(frozen=True)
+class FileWalk:
+    """A trajectory file walked as it is (``walk --trajectory``): its heel strikes stand for the plan."""
+
+    heel_strikes: tuple
+
+    @property
+    def planned_steps(self) -> tuple:
+        return self.heel_strikes
+
+
+#: A trajectory file's sample times must be this close to one period apart (share of the period).
+UNIFORM_RATE_TOL = 1e-3
+
+
+def trajectory_file_walk(args) -> tuple[GaitSource, FileWalk, Trajectory]:
+    """``--trajectory FILE``: the file streamed frame by frame at its own (uniform) rate, which the bus must carry."""
+    if getattr(args, "rate", None) is not None:
+        raise UsageError("--rate: a trajectory file is walked at its own frame rate; leave --rate out")
+    source = gait_source(args)
+    trajectory = Trajectory.load(args.trajectory)
+    periods = np.diff(trajectory.t_s)
+    period = float(np.median(periods))
+    worst = float(np.abs(periods - period).max())
+    if worst > UNIFORM_RATE_TOL * period:
+        k = int(np.argmax(np.abs(periods - period)))
+        raise UsageError(f"--trajectory {args.trajectory}: samples are not evenly spaced (row {k + 3} comes "
+                         f"{periods[k]:.6g} s after the one before, the median spacing is {period:.6g} s); "
+                         f"the robot is sent one row per frame")
+    rate = 1.0 / period
+    if source.robot is not None:
+        config = source.robot
+        try:
+            check_rate(rate, config.bus.backend, config.bus.protocol, config.joints[0].model, len(config.joints),
+                       config.bus.baudrate, read_back=True)
+        except ValueError as exc:
+            raise UsageError(f"--trajectory {args.trajectory}: its {rate:.4g} Hz: {exc}") from None
+    settings = WalkSettings(source.settings.cycle_s, rate, source.settings.clearance)
+    return GaitSource(source.geometry, settings, source.max_step_m, source.robot), \
+        FileWalk(tuple(trajectory.heel_strikes)), trajectory
+
+
 def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:
+    if getattr(args, "trajectory", None) is not None:
+        return trajectory_file_walk(args)
     if getattr(args, "terrain", None) is not None:
         source, walk = build_terrain_walk(args)
         return source, walk, walk.trajectory

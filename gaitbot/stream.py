@@ -28,6 +28,7 @@ import signal
 import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -39,7 +40,8 @@ from gaitbot.ramp import brake_ticks, ramp_ticks, stop_ticks
 
 __all__ = [
     "Clock", "MonotonicClock", "VirtualClock", "ramp_ticks", "brake_ticks", "stop_ticks",
-    "StreamStats", "Streamer", "MissingServosError", "Terminated", "prepare",
+    "StreamStats", "Streamer", "MissingServosError", "Terminated", "prepare", "paced_deadlines",
+    "sigterm_raises_terminated",
     "SessionResult", "walk_session", "latency_timer_warning",
     "LATE_THRESHOLD_S", "EXIT_CODES",
 ]
@@ -217,13 +219,10 @@ class Streamer:
         clock, bus, ids, cpu, monitor = self.clock, self.bus, self.ids, self.cpu_time_s, self.monitor
         cpu_start = cpu()
         start_s = clock.now() if start_s is None else start_s
-        earliest_s = start_s
         self.next_deadline_s = start_s
         try:
-            for k in range(count):
-                deadline_s = start_s + k * self.period_s
-                clock.sleep_until(max(deadline_s, earliest_s))
-                send_s = clock.now()
+            ticks = paced_deadlines(clock, self.period_s, start_s, self.min_frame_interval_s)
+            for _, (k, deadline_s, send_s) in zip(range(count), ticks):
                 work_cpu_start = cpu()
                 self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frames[k]
                 # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
@@ -235,13 +234,30 @@ class Streamer:
                 self.next_deadline_s = deadline_s + self.period_s
                 stats._record(send_s - deadline_s, done_s - send_s)
                 stats.wall_s = done_s - start_s
-                earliest_s = send_s + self.min_frame_interval_s
                 if self.on_frame is not None:
                     self.on_frame(k, stats)
                 stats.work_cpu_s += cpu() - work_cpu_start
         finally:
             stats.cpu_s = cpu() - cpu_start
         return stats
+
+
+def paced_deadlines(clock: Clock, period_s: float, start_s: float, min_interval_s: float):
+    """The pacing rule of the module docstring, for any per-frame work (sending goals, reading positions).
+
+    Yields ``(k, deadline_s, start_s_of_work)`` for k = 0, 1, ...: waits until frame k's absolute
+    deadline ``start_s + k * period_s`` but never less than ``min_interval_s`` after the previous
+    frame's work started, then reports the time the work starts. Deadlines are never re-anchored;
+    nothing is skipped. Stop iterating to stop (the generator sleeps only when asked for a frame)."""
+    earliest_s = start_s
+    k = 0
+    while True:
+        deadline_s = start_s + k * period_s
+        clock.sleep_until(max(deadline_s, earliest_s))
+        work_s = clock.now()
+        yield k, deadline_s, work_s
+        earliest_s = work_s + min_interval_s
+        k += 1
 
 
 def _as_tick_frames(frames: ArrayLike, joint_count: int) -> np.ndarray:
@@ -527,6 +543,16 @@ class _SessionState:
 
 
 _NOT_INSTALLED = object()
+
+
+@contextmanager
+def sigterm_raises_terminated():
+    """Within the block, SIGTERM raises :class:`Terminated` in the main thread (elsewhere: no change)."""
+    old_handler = _install_sigterm_handler()
+    try:
+        yield
+    finally:
+        _restore_sigterm_handler(old_handler)
 
 
 def _install_sigterm_handler() -> object:

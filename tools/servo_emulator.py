@@ -41,6 +41,15 @@ goal frames and ``--fault-after-s`` seconds from the first packet received (defa
 * ``--close-after-frames N`` / ``--close-after-s T``: the port disappears (the pty master is
   closed and the emulator exits) after N goal frames or T seconds from the first packet.
 
+A scripted hand (``--hand FILE``, a trajectory .csv/.npz turned into ticks by ``--robot``'s
+calibration, or ``Hand`` from tests) moves the servos while their torque is off, as a person moving
+the legs for ``gaitbot record`` would: from the first torque-off write, a servo with torque off
+reports the hand's current sample as its present position. The hand advances one sample per read
+cycle (a present-position read of a servo already read at this sample starts the next one; sync
+reads, bulk reads and one read per servo all count the same way), so a recording sees every sample
+exactly once whatever the host's timing; with ``--hand-rate HZ`` it advances with time instead.
+After its last sample the hand stays there.
+
 ``--log goals.jsonl`` writes every goal-position packet received in the bus recording format
 (gaitbot.bus.recording), so ``gaitbot.bus.log_decoder.decode_goal_frames`` reads it back.
 
@@ -60,7 +69,6 @@ import time
 import tty
 from collections import deque
 from dataclasses import dataclass, field
-from pathlib import Path
 
 try:
     from gaitbot.bus import wire
@@ -132,6 +140,25 @@ class Faults:
 
 
 @dataclass
+class Hand:
+    """Ticks per servo id, one entry per sample; ``rate_hz`` None: one sample per read cycle."""
+
+    ticks: dict[int, list[int]]
+    rate_hz: float | None = None
+
+    def __post_init__(self) -> None:
+        lengths = {len(v) for v in self.ticks.values()}
+        if len(lengths) != 1 or 0 in lengths:
+            raise ValueError("the hand needs the same number (at least one) of samples for every servo")
+        if self.rate_hz is not None and not self.rate_hz > 0:
+            raise ValueError(f"--hand-rate must be a positive rate in Hz, got {self.rate_hz}")
+
+    @property
+    def samples(self) -> int:
+        return len(next(iter(self.ticks.values())))
+
+
+@dataclass
 class EmulatorConfig:
     backend: str
     protocol: float
@@ -143,6 +170,7 @@ class EmulatorConfig:
     joints: dict[str, int] | None = None
     seed: int = 0
     return_delay_us: float | None = None  # overrides every servo's Return Delay Time register
+    hand: Hand | None = None  # moves servos whose torque is off (see the module docstring)
 
 
 class EmulatedChain(MockPort):
@@ -167,6 +195,10 @@ class EmulatedChain(MockPort):
         self._rng = random.Random(config.seed)
         self._registered: dict[int, tuple[int, bytes]] = {}
         self._present = {i: float(m.centre_tick) for i, m in self.models.items()}
+        self.hand = config.hand
+        self.hand_sample = 0
+        self._hand_grabbed_s: float | None = None  # when the first torque-off came; None: not yet
+        self._hand_read: set[int] = set()  # servos read at the current hand sample
         self._moved_at_s = {i: 0.0 for i in self.models}
         for servo_id, model in self.models.items():
             layout = LAYOUTS[model.name]
@@ -241,7 +273,10 @@ class EmulatedChain(MockPort):
         goal = int.from_bytes(table[model.addr_goal_position:model.addr_goal_position + model.len_goal_position],
                               model.byte_order, signed=model.len_goal_position == 4)
         present = self._present[servo_id]
-        if table[model.addr_torque_enable]:
+        if not table[model.addr_torque_enable] and self._hand_grabbed_s is not None and servo_id in self.hand.ticks:
+            script = self.hand.ticks[servo_id]
+            present = self._present[servo_id] = float(script[min(self.hand_sample, len(script) - 1)])
+        elif table[model.addr_torque_enable]:
             step = model.no_load_speed_dps * model.ticks_per_rad * (3.141592653589793 / 180.0) * dt_s
             present = goal if abs(goal - present) <= step else present + step * (1 if goal > present else -1)
             self._present[servo_id] = present
@@ -255,10 +290,12 @@ class EmulatedChain(MockPort):
     def _answer(self, raw: bytes) -> None:
         if self.first_packet_s is None:
             self.first_packet_s = self.now_s
+        frame = wire.parse(raw, self.framing, status=False)
+        if frame.checksum_ok and self._hand_grabbed_s is not None:
+            self._move_hand(frame)
         for servo_id in self.models:
             self._advance(servo_id)
         self._apply_error_faults()
-        frame = wire.parse(raw, self.framing, status=False)
         if not frame.checksum_ok:
             self.rejected.append((raw, frame.problem))
             return
@@ -279,6 +316,50 @@ class EmulatedChain(MockPort):
         else:
             self._unsupported(frame)
         self._log_goals(raw, frame)
+
+    # --- the scripted hand -----------------------------------------------------------------
+    def _move_hand(self, frame: wire.Frame) -> None:
+        """Advance the hand: with time at ``rate_hz``, or by one sample when a read cycle ends."""
+        if self.hand.rate_hz is not None:
+            self.hand_sample = int((self.now_s - self._hand_grabbed_s) * self.hand.rate_hz)
+            return
+        read = self._present_position_reads(frame)
+        if self._hand_read & set(read):
+            self.hand_sample += 1
+            self._hand_read.clear()
+        self._hand_read.update(read)
+
+    def _present_position_reads(self, frame: wire.Frame) -> list[int]:
+        """Servo ids whose present position this instruction reads (read, sync read, bulk read)."""
+        first = next(iter(self.models.values()))
+        wanted = first.addr_present_position
+
+        def covers(address: int, length: int) -> bool:
+            return address <= wanted < address + length
+
+        p, v2 = frame.params, self.framing == "v2"
+        if frame.instruction == wire.INST_READ:
+            address, rest = self._address_and_rest(p)
+            length = rest[0] | (rest[1] << 8 if v2 else 0)
+            return [frame.packet_id] if frame.packet_id in self.tables and covers(address, length) else []
+        if frame.instruction == wire.INST_SYNC_READ:
+            address, rest = self._address_and_rest(p)
+            length, ids = (rest[0] | rest[1] << 8, rest[2:]) if v2 else (rest[0], rest[1:])
+            return [i for i in ids if i in self.tables] if covers(address, length) else []
+        if frame.instruction == INST_BULK_READ and v2:
+            return [p[o] for o in range(0, len(p) - 4, 5)
+                    if p[o] in self.tables and covers(p[o + 1] | p[o + 2] << 8, p[o + 3] | p[o + 4] << 8)]
+        return []
+
+    def _grab_by_hand(self, servo_id: int, address: int, data: bytes) -> None:
+        """The hand takes the legs at the first torque-off write (its sample 0 is read next)."""
+        model = self.models[servo_id]
+        if self.hand is None or self._hand_grabbed_s is not None or not address <= model.addr_torque_enable < address + len(data):
+            return
+        if data[model.addr_torque_enable - address] == 0:
+            self._hand_grabbed_s = self.now_s
+            self.hand_sample = 0
+            self._hand_read.clear()
 
     def _unsupported(self, frame: wire.Frame) -> None:
         if frame.packet_id in self.tables:
@@ -339,6 +420,7 @@ class EmulatedChain(MockPort):
         """Write the control table; unlike the ideal mock servo, present position is left to motion."""
         self._advance(servo_id)
         self.tables[servo_id][address:address + len(data)] = data
+        self._grab_by_hand(servo_id, address, data)
 
     # --- replies ------------------------------------------------------------------------------
     def _status_wanted(self, servo_id: int) -> bool:
@@ -511,9 +593,12 @@ def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
         from gaitbot.robot.config import load_robot_config, resolve_config
 
         robot = load_robot_config(resolve_config(args.robot))
+        hand = hand_from_trajectory(robot, args.hand, args.hand_rate) if args.hand else None
         return EmulatorConfig(robot.bus.backend, robot.bus.protocol, robot.models_by_id,
                               args.baudrate or robot.bus.baudrate, faults, args.log, robot.name,
-                              {j.name: j.id for j in robot.joints}, args.seed, args.return_delay_us)
+                              {j.name: j.id for j in robot.joints}, args.seed, args.return_delay_us, hand)
+    if args.hand:
+        raise ValueError("--hand needs --robot (its calibration turns the trajectory's angles into ticks)")
     if not args.protocol:
         raise ValueError("give --robot CONFIG or --protocol dxl1|dxl2|feetech-sts|feetech-scs with --ids")
     backend, protocol, default_model = PROTOCOLS[args.protocol]
@@ -523,6 +608,21 @@ def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
     models = {i: model for i in parse_ids(args.ids)}
     return EmulatorConfig(backend, protocol, models, args.baudrate or 1_000_000, faults, args.log,
                           seed=args.seed, return_delay_us=args.return_delay_us)
+
+
+def hand_from_trajectory(robot, path: str, rate_hz: float | None = None) -> Hand:
+    """A hand playing a trajectory file (.csv/.npz): its angles through the robot's calibration, held
+    joints at their hold angle. Ticks outside a servo's encoder range cannot be reported: refused."""
+    from gaitbot.gait.trajectory import Trajectory
+    from gaitbot.robot.calibration import angles_to_ticks
+
+    ticks = angles_to_ticks(robot, Trajectory.load(path).angles_rad)
+    for column, joint in enumerate(robot.joints):
+        low, high = int(ticks[:, column].min()), int(ticks[:, column].max())
+        if low < joint.model.min_tick or high > joint.model.max_tick:
+            raise ValueError(f"--hand {path}: {joint.name} goes to ticks {low}..{high}, outside the "
+                             f"{joint.model.name}'s {joint.model.min_tick}..{joint.model.max_tick}")
+    return Hand({joint.id: ticks[:, column].tolist() for column, joint in enumerate(robot.joints)}, rate_hz)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -545,6 +645,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fault-after-s", type=float, default=0.0, help="faults start this long after the first packet")
     p.add_argument("--close-after-frames", type=int, help="the port disappears after this many goal frames")
     p.add_argument("--close-after-s", type=float, help="the port disappears this long after the first packet")
+    p.add_argument("--hand", metavar="FILE", help="with --robot: a trajectory (.csv/.npz) a hand plays on the servos "
+                   "while their torque is off, one sample per read cycle")
+    p.add_argument("--hand-rate", type=float, metavar="HZ", help="advance the --hand script with time at HZ instead")
     return p
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import io
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -97,6 +98,38 @@ class Trajectory:
         if path.suffix == ".csv":
             return _load_csv(path)
         raise TrajectoryFileError(f"{path}: unknown trajectory format {path.suffix!r} (allowed: .csv, .npz)")
+
+
+class CsvTrajectoryWriter:
+    """A trajectory CSV written row by row (``gaitbot record``), readable at every moment.
+
+    The header goes out at once; every row is handed to the operating system as it is written
+    (one ``write`` of the whole line, then ``flush``), so a process that stops for any reason,
+    even SIGKILL, leaves a file holding every complete row; ``sync()`` (fsync) also makes it
+    survive a power cut. Same columns and number format as ``Trajectory.save``.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self.rows = 0
+        self._file = open(self.path, "w", newline="", encoding="ascii")
+        self._file.write(",".join(CSV_COLUMNS) + "\n")
+        self._file.flush()
+
+    def write(self, t_s: float, angles_rad, root_m) -> None:
+        values = [float(t_s), *np.degrees(np.asarray(angles_rad, dtype=float)), *np.asarray(root_m, dtype=float)]
+        self._file.write(",".join(f"{v + 0.0:.9g}" for v in values) + "\n")  # + 0.0: no "-0" in the file
+        self._file.flush()
+        self.rows += 1
+
+    def sync(self) -> None:
+        os.fsync(self._file.fileno())
+
+    def close(self) -> None:
+        if not self._file.closed:
+            self._file.flush()
+            self.sync()
+            self._file.close()
 
 
 def _from_table(path: Path, t: np.ndarray, angles_deg: np.ndarray, root: np.ndarray, strikes=()) -> Trajectory:

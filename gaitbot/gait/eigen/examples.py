@@ -1,10 +1,11 @@
 """Example cycles from trajectory files (seed 004 section 3: cycle segmentation).
 
 A cycle runs from a left heel strike to the next left heel strike (two steps, gait-model.md
-section 1). Trajectory ``.npz`` files carry their heel strikes; CSV files do not, so heel strikes
-are detected from foot contact with forward kinematics: in the body frame, a leg's foot is in the
-air while its lowest sole point is more than ``contact_tol_m`` above the other foot's; its heel
-strike is the first frame at which it comes back down to (nearly) the other foot's level.
+section 1). Trajectory ``.npz`` files carry their heel strikes; CSV files (and recordings) do not,
+so heel strikes are detected from foot contact with forward kinematics (gait/footfall.py, the rule
+``gaitbot plot`` uses too): a leg's foot is in the air while its lowest sole point is more than
+``contact_tol_m`` above the other foot's; its heel strike is the first frame at which it comes
+back down to (nearly) the other foot's level.
 
 Only the steady part of a walk gives examples: a generated walk starts from standing (its first
 step starts at rest) and ends with a closing step, so cycles that start at the first heel strike
@@ -18,11 +19,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..contact import leg_pitch, lowest_sole_y
-from ..geometry import LegGeometry, ankle_position, foot_points
-from ..trajectory import HeelStrike, Trajectory
+from ..footfall import CONTACT_TOL_FRACTION, foot_heights_in_body, heel_strikes_from_heights
+from ..geometry import LegGeometry, leg_points
+from ..trajectory import Trajectory
 
-CONTACT_TOL_FRACTION = 0.01  # of the leg length: 2.2 mm for a 0.22 m leg
+__all__ = ["CONTACT_TOL_FRACTION", "ExampleCycle", "ExampleError", "cycles_from_trajectory", "detect_heel_strikes",
+           "foot_heights_in_body", "heel_world_x", "walk_label"]
 
 
 class ExampleError(ValueError):
@@ -41,42 +43,22 @@ class ExampleCycle:
     source: str = ""
 
 
-def foot_heights_in_body(geometry: LegGeometry, angles_rad: np.ndarray) -> np.ndarray:
-    """(N, 2) height of the lowest sole point of the left and right foot relative to the hip."""
+def heel_world_x(geometry: LegGeometry, trajectory: Trajectory) -> np.ndarray:
+    """(N, 2) world x of the left and right heel."""
     out = []
     for side in (0, 1):
-        q = angles_rad[:, 3 * side:3 * side + 3]
-        out.append(lowest_sole_y(geometry, ankle_position(geometry, q[:, 0], q[:, 1]), leg_pitch(q)))
+        q = trajectory.angles_rad[:, 3 * side:3 * side + 3]
+        _, _, heel, _ = leg_points(geometry, q[:, 0], q[:, 1], q[:, 2])
+        out.append(heel[:, 0] + trajectory.root_m[:, 0])
     return np.column_stack(out)
 
 
-def heel_world_x(geometry: LegGeometry, trajectory: Trajectory, frame: int, leg: str) -> float:
-    side = 0 if leg == "left" else 1
-    q = trajectory.angles_rad[frame, 3 * side:3 * side + 3]
-    ankle = ankle_position(geometry, q[0], q[1])
-    heel, _ = foot_points(geometry, ankle, leg_pitch(q))
-    return float(heel[0] + trajectory.root_m[frame, 0])
-
-
 def detect_heel_strikes(trajectory: Trajectory, geometry: LegGeometry, contact_tol_m: float | None = None):
-    """Heel strikes from foot contact (for files without them): list of HeelStrike.
-
-    A foot is in the air once its lowest sole point is more than ``contact_tol_m`` (default
-    CONTACT_TOL_FRACTION of the leg) above the other foot's; its heel strike is the first frame
-    after that at which it is back within a tenth of that of the other foot's level."""
+    """Heel strikes from foot contact (for files without them): list of HeelStrike (footfall.py's rule,
+    with feet heights relative to the hip, so a file without a root still gives their times)."""
     tol = CONTACT_TOL_FRACTION * geometry.leg_length if contact_tol_m is None else contact_tol_m
-    heights = foot_heights_in_body(geometry, trajectory.angles_rad)
-    strikes = []
-    for side, leg in ((0, "left"), (1, "right")):
-        gap = heights[:, side] - heights[:, 1 - side]
-        airborne = False
-        for k, value in enumerate(gap):
-            if value > tol:
-                airborne = True
-            elif airborne and value <= 0.1 * tol:
-                strikes.append(HeelStrike(float(trajectory.t_s[k]), leg, heel_world_x(geometry, trajectory, k, leg)))
-                airborne = False
-    return sorted(strikes, key=lambda h: h.t_s)
+    return heel_strikes_from_heights(trajectory.t_s, foot_heights_in_body(geometry, trajectory.angles_rad),
+                                     heel_world_x(geometry, trajectory), tol)
 
 
 def _frame_of(trajectory: Trajectory, t_s: float) -> int:

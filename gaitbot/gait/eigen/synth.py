@@ -13,21 +13,17 @@ Choices (stated once):
   within a cycle the coefficients go linearly from the cycle's start value to its end value, so
   the motion is continuous (seed 004 section 7, Figs. 8 and 9).
 - Root: the contact model of the walker (contact.py): the stance foot rolls without slip about its
-  lowest sole point, the root follows it in closed form (``grounded_ankle`` minus the ankle in the
-  body frame, as segments.root_of). The stance foot is the one whose lowest sole point is lower;
-  it stays locked while it supports, and the other foot takes over only once it is lower by more
-  than ``switch_tol`` (so two feet both on the ground do not flicker). At a switch the new stance
-  foot's anchor is taken from where it is, so the root never jumps in x.
+  lowest sole point, the root follows it in closed form; which foot supports is read from the
+  angles (gait/footfall.py ``root_from_contact``, also used by ``gaitbot record``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..contact import ankle_in_body, grounded_ankle, leg_pitch
+from ..footfall import root_from_contact
 from ..geometry import LegGeometry, leg_points
 from ..trajectory import HeelStrike, Trajectory
-from .examples import CONTACT_TOL_FRACTION, foot_heights_in_body
 from .model import EigenGaitModel, EigenModelError
 
 
@@ -93,39 +89,6 @@ def join_smoothly(head: np.ndarray, body: np.ndarray, tail: np.ndarray, fade_fra
     want_ve = tail[1] - tail[0]
     body += _quintic_fade(xe, want_end - body[-1], -(want_ve - got_ve) * fade)
     return np.vstack([head, body, tail])
-
-
-def root_from_contact(geometry: LegGeometry, angles_rad: np.ndarray, start_root, land_tol: float | None = None):
-    """Root (N, 2) keeping the supporting foot still (see the module docstring), and the stance leg per frame.
-
-    The other foot takes over once it is lower than the stance foot by more than ``land_tol``
-    (metres; default a quarter of CONTACT_TOL_FRACTION of the leg): with both feet on the ground
-    the stance foot stays locked until it lifts.
-    """
-    tol = 0.25 * CONTACT_TOL_FRACTION * geometry.leg_length if land_tol is None else land_tol
-    heights = foot_heights_in_body(geometry, angles_rad)
-    legs = [angles_rad[:, 0:3], angles_rad[:, 3:6]]
-    pitch = [leg_pitch(q) for q in legs]
-    ankle = [ankle_in_body(geometry, q) for q in legs]
-    n = len(angles_rad)
-    root = np.empty((n, 2))
-    stance = np.empty(n, dtype=int)
-    current = int(np.argmin(heights[0]))
-
-    def anchor_for(leg: int, k: int, root_k) -> float:
-        # grounded_ankle is x-linear in the anchor with unit slope: invert it at this frame
-        world_ankle_x = root_k[0] + ankle[leg][k, 0]
-        return float(world_ankle_x - grounded_ankle(geometry, 0.0, pitch[leg][k])[0])
-
-    anchor = anchor_for(current, 0, np.asarray(start_root, float))
-    for k in range(n):
-        other = 1 - current
-        if k > 0 and heights[k, other] < heights[k, current] - tol:
-            anchor = anchor_for(other, k, root[k - 1])
-            current = other
-        root[k] = grounded_ankle(geometry, anchor, pitch[current][k]) - ankle[current][k]
-        stance[k] = current
-    return root, stance
 
 
 def heel_x(geometry: LegGeometry, angles_rad, root, frame: int, leg: str) -> float:

@@ -1,0 +1,194 @@
+"""Recording a motion a person makes with the robot's legs: torque off, present positions read at the frame rate.
+
+This module knows servo ids, ticks, a :class:`~gaitbot.bus.base.Bus` and a clock (the stream
+room's vocabulary); what a sample becomes (angles, a root, a CSV row) is the ``sink``'s business
+(gaitbot/record_command.py), so data still flows one way inside each room.
+
+Sequence (:func:`record_session`): open the bus -> ping every servo and read where they are
+(:func:`gaitbot.stream.prepare`; a missing servo stops here, nothing written) -> ask
+``confirm(n)`` (a refusal ends here: nothing sent, torque as it was, no file) -> ``sink.open()``
+-> torque off on every servo -> read every servo's present position (sync read where the
+protocol has one) on the absolute-deadline grid of the streamer (:func:`gaitbot.stream.paced_deadlines`:
+sample k due at ``k * period``, never re-anchored, never skipped, never in a burst) and hand each
+sample to ``sink.add(t_s, ticks)`` with ``t_s = k * period`` -> end.
+
+Ways out, and the state each leaves (the torque is off throughout the recording, since a hand
+moves the legs):
+
+* completed (exit 0): ``n_samples`` read;
+* stopped (exit 0): Ctrl-C, the usual way to end a recording without ``n_samples``;
+* terminated (exit 143): SIGTERM;
+* bus_error (exit 1): a servo stops answering, reports an error, or the port disappears.
+
+Torque stays off at every exit (the person holding the legs keeps them). With ``hold_at_end``,
+after a completed, stopped or terminated recording the pose is held instead: present positions
+are read once more, written as goals (through the caller's LimitGuard, which refuses a pose
+outside the joint limits) and torque goes on, in that order, as a walk starts. If any of that
+fails, torque goes off again on every servo and a note says why. After a bus error nothing more
+is tried beyond the torque-off that is already in place. ``sink.close()`` and ``bus.close()``
+run in a ``finally``, so every sample read is in the file whatever happens.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from contextlib import nullcontext
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from gaitbot.bus.base import Bus, BusError
+from gaitbot.clock import Clock, MonotonicClock
+from gaitbot.stream import EXIT_CODES, LATE_THRESHOLD_S, Terminated, paced_deadlines, prepare, sigterm_raises_terminated
+
+#: Exit status of each outcome: a stopped recording (Ctrl-C) is a normal end.
+RECORD_EXIT_CODES = {"declined": 0, "completed": 0, "stopped": 0, "terminated": EXIT_CODES["terminated"],
+                     "bus_error": EXIT_CODES["bus_error"]}
+#: fsync the sink about once a second (every row is flushed to the OS as it is written anyway).
+SYNC_EVERY_S = 1.0
+
+
+class SampleSink(Protocol):
+    """Where samples go: opened after consent, before torque off; closed at every exit."""
+
+    def open(self) -> None: ...
+
+    def add(self, t_s: float, ticks: np.ndarray) -> None:
+        """One sample: ``t_s`` its planned time from the first sample, ``ticks`` in the ``ids`` order."""
+
+    def sync(self) -> None: ...
+
+    def close(self) -> None: ...
+
+
+@dataclass
+class ReadTiming:
+    """Lateness of each read (start - deadline) and how long each took, seconds."""
+
+    period_s: float
+    lateness_s: list[float] = field(default_factory=list)
+    read_s: list[float] = field(default_factory=list)
+
+    @property
+    def samples(self) -> int:
+        return len(self.read_s)
+
+    def summary(self) -> str:
+        if not self.read_s:
+            return "no samples read"
+        late, read, ms = np.array(self.lateness_s), np.array(self.read_s), 1e3
+        n_late = int(np.sum(late > LATE_THRESHOLD_S))
+        return (f"Read {self.samples} samples at {1.0 / self.period_s:.0f} Hz; {n_late} started more than "
+                f"{LATE_THRESHOLD_S * ms:.1f} ms late (max {late.max() * ms:.3f} ms; rows keep their planned times). "
+                f"Read time median {np.median(read) * ms:.3f} ms, p99 {np.percentile(read, 99) * ms:.3f} ms, "
+                f"max {read.max() * ms:.3f} ms.")
+
+
+@dataclass(frozen=True)
+class RecordResult:
+    """How a recording ended: outcome (see the module docstring), exit code, samples read,
+    the bus error if any, whether torque is off or holding at the end, and notes for people."""
+
+    outcome: str
+    exit_code: int
+    samples: int
+    timing: ReadTiming
+    error: BaseException | None = None
+    torque: str = "unchanged"  # "unchanged" | "off" | "holding"
+    notes: tuple[str, ...] = ()
+
+    def message(self) -> str:
+        head = {"declined": "Recording cancelled: nothing was sent, torque left as it was",
+                "completed": "Recording completed", "stopped": "Recording stopped (Ctrl-C)",
+                "terminated": "Recording terminated (SIGTERM)", "bus_error": "Recording stopped by a bus error"}
+        parts = [head[self.outcome]]
+        if self.error is not None:
+            parts.append(f"error: {self.error}")
+        parts.extend(self.notes)
+        return "; ".join(parts) + "."
+
+
+def record_session(bus: Bus, ids: Sequence[int], period_s: float, sink: SampleSink, *,
+                   confirm: Callable[[int], bool], n_samples: int | None = None, clock: Clock | None = None,
+                   hold_at_end: bool = False, handle_sigterm: bool = True) -> RecordResult:
+    """Record until ``n_samples`` are read, Ctrl-C, SIGTERM or a bus error (see the module docstring).
+
+    ``confirm(n)`` asks the person whether ``n`` servos may go limp. ``bus`` should be wrapped in a
+    LimitGuard when ``hold_at_end`` is set, so a pose outside the limits is never sent as a goal.
+    """
+    ids = [int(i) for i in ids]
+    if n_samples is not None and n_samples < 1:
+        raise ValueError(f"n_samples must be 1 or more, got {n_samples}")
+    clock = clock if clock is not None else MonotonicClock()
+    timing = ReadTiming(period_s)
+    notes: list[str] = []
+    state = {"torque": "unchanged", "sink_open": False, "opened": False}
+    outcome, error = "completed", None
+    with sigterm_raises_terminated() if handle_sigterm else nullcontext():
+        try:
+            try:
+                state["opened"] = True
+                bus.open()
+                prepare(bus, ids)
+                if not confirm(len(ids)):
+                    return RecordResult("declined", RECORD_EXIT_CODES["declined"], 0, timing)
+                sink.open()
+                state["sink_open"] = True
+                state["torque"] = "off"  # before the call: a torque-off that fails halfway is still off where it took
+                bus.set_torque(ids, False)
+                _read_loop(bus, ids, period_s, sink, clock, timing, n_samples)
+            except KeyboardInterrupt:  # before torque off (at the question) it is a refusal
+                outcome = "stopped" if state["torque"] == "off" else "declined"
+            except Terminated:
+                outcome = "terminated"
+            except BusError as exc:
+                outcome, error = "bus_error", exc
+            if hold_at_end and outcome != "bus_error" and state["torque"] == "off":
+                state["torque"] = _hold_present_pose(bus, ids, notes)
+            elif state["torque"] == "off":
+                notes.append("torque stays off")
+        finally:
+            if state["sink_open"]:
+                sink.close()
+            if state["opened"]:
+                try:
+                    bus.close()
+                except Exception as exc:  # noqa: BLE001 - reported, must not hide how the recording ended
+                    notes.append(f"closing the bus failed: {exc}")
+    return RecordResult(outcome, RECORD_EXIT_CODES[outcome], timing.samples, timing, error, state["torque"],
+                        tuple(notes))
+
+
+def _read_loop(bus: Bus, ids: list[int], period_s: float, sink: SampleSink, clock: Clock, timing: ReadTiming,
+               n_samples: int | None) -> None:
+    start_s = clock.now()
+    sync_every = max(1, int(round(SYNC_EVERY_S / period_s)))
+    for k, deadline_s, read_start_s in paced_deadlines(clock, period_s, start_s, 0.9 * period_s):
+        if n_samples is not None and k >= n_samples:
+            return
+        present = bus.read_present_ticks(ids)
+        done_s = clock.now()
+        timing.lateness_s.append(read_start_s - deadline_s)
+        timing.read_s.append(done_s - read_start_s)
+        sink.add(k * period_s, np.array([int(present[i]) for i in ids], dtype=np.int64))
+        if (k + 1) % sync_every == 0:
+            sink.sync()
+
+
+def _hold_present_pose(bus: Bus, ids: list[int], notes: list[str]) -> str:
+    """Present pose as goal, then torque on (the order a walk starts in); on any failure torque off again."""
+    try:
+        present = bus.read_present_ticks(ids)
+        bus.write_goal_ticks({i: int(present[i]) for i in ids})
+        bus.set_torque(ids, True)
+        notes.append("torque on, holding the pose read last")
+        return "holding"
+    except (BusError, KeyboardInterrupt, Terminated) as exc:
+        reason = "interrupted" if not isinstance(exc, BusError) else str(exc)
+        try:
+            bus.set_torque(ids, False)
+            notes.append(f"pose not held ({reason}); torque stays off")
+        except (BusError, KeyboardInterrupt, Terminated) as again:
+            notes.append(f"pose not held ({reason}); torque off failed too: {again}")
+        return "off"

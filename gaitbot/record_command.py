@@ -1,0 +1,170 @@
+"""``gaitbot record``: wiring from arguments to a bus, a question, and a trajectory CSV (gaitbot/record.py).
+
+What a sample becomes (:class:`TrajectorySink`): ticks -> joint angles through the robot's
+calibration (the exact inverse of the map a walk uses) -> the root from foot contact
+(gait/footfall.py ``ContactRoot``: the lower foot is taken as standing on flat ground, so the
+file walks like the walker's and eigen-synthesised walks do) -> one CSV row, written and flushed
+at once (gait/trajectory.py ``CsvTrajectoryWriter``).
+
+A hand can move a leg anywhere: positions outside a joint's limits are recorded as read, with a
+warning the first time each joint leaves its limits and a summary at the end. ``gaitbot check``
+reports them as errors (exit 1), ``gaitbot walk --trajectory`` refuses such a file before anything
+moves, and ``gaitbot eigen fit`` learns from it but warns, since walks synthesised near it may be
+refused in turn.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from gaitbot.bus.factory import make_bus
+from gaitbot.bus.guard import LimitGuard
+from gaitbot.clock import MonotonicClock, VirtualClock
+from gaitbot.gait.footfall import ContactRoot
+from gaitbot.gait.trajectory import CsvTrajectoryWriter
+from gaitbot.record import record_session
+from gaitbot.robot.calibration import ticks_to_angles, tick_limits
+from gaitbot.robot.config import RobotConfig
+from gaitbot.robot.gait_setup import leg_geometry
+from gaitbot.session import UsageError, load_robot
+
+QUESTION = "Turn torque off on {n} servos? The legs will go limp. [y/N] "
+
+
+class LimitWatch:
+    """Joints seen outside their limits while recording: warn once per joint, summarise at the end."""
+
+    def __init__(self, config: RobotConfig, warn) -> None:
+        self.names = [j.name for j in config.joints]
+        self.low = np.array([j.min_deg for j in config.joints])
+        self.high = np.array([j.max_deg for j in config.joints])
+        self.warn = warn
+        self.outside: dict[str, list] = {}  # joint -> [samples outside, worst excess deg, worst value deg, t_s]
+
+    def see(self, t_s: float, angles_deg: np.ndarray) -> None:
+        excess = np.maximum(self.low - angles_deg, angles_deg - self.high)
+        for j in np.flatnonzero(excess > 0):
+            name = self.names[j]
+            seen = self.outside.get(name)
+            if seen is None:
+                self.warn(f"t={t_s:.3f} s: {name} at {angles_deg[j]:.1f} deg is outside its limits "
+                          f"{self.low[j]:g} to {self.high[j]:g} deg (recorded as read)")
+                seen = self.outside[name] = [0, 0.0, 0.0, t_s]
+            seen[0] += 1
+            if excess[j] > seen[1]:
+                seen[1:] = [float(excess[j]), float(angles_deg[j]), t_s]
+
+    def summary(self) -> list[str]:
+        return [f"{name} outside its limits in {n} samples, worst {value:.1f} deg at t={t:.3f} s"
+                for name, (n, _, value, t) in self.outside.items()]
+
+
+class TrajectorySink:
+    """Samples of ticks (the config's joint order) -> rows of a trajectory CSV (see the module docstring)."""
+
+    def __init__(self, config: RobotConfig, path: Path, warn) -> None:
+        self.config = config
+        self.path = path
+        self.limits = LimitWatch(config, warn)
+        self.writer: CsvTrajectoryWriter | None = None
+        self.root: ContactRoot | None = None
+        self.last_root_m = np.zeros(2)
+
+    def open(self) -> None:
+        self.writer = CsvTrajectoryWriter(self.path)
+        self.root = ContactRoot(leg_geometry(self.config))
+
+    def add(self, t_s: float, ticks: np.ndarray) -> None:
+        angles_rad = ticks_to_angles(self.config, ticks)
+        self.last_root_m = self.root.update(angles_rad[:6])
+        self.writer.write(t_s, angles_rad[:6], self.last_root_m)
+        self.limits.see(t_s, np.degrees(angles_rad))
+
+    def sync(self) -> None:
+        self.writer.sync()
+
+    def close(self) -> None:
+        self.writer.close()
+
+
+def ask_torque_off(n: int) -> bool:
+    """The question on the terminal; anything but y/yes (or end of input) is no."""
+    try:
+        answer = input(QUESTION.format(n=n))
+    except EOFError:
+        print(file=sys.stderr)  # end the prompt's line
+        return False
+    return answer.strip().lower() in ("y", "yes")
+
+
+def _check_output(out: Path) -> None:
+    if out.suffix != ".csv":
+        raise UsageError(f"-o {out}: a recording is written as it is read, in the trajectory CSV format: "
+                         f"the file must end in .csv")
+    if out.is_dir():
+        raise UsageError(f"-o {out}: is a directory")
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir() or not os.access(parent, os.W_OK) or (out.exists() and not os.access(out, os.W_OK)):
+        raise UsageError(f"-o {out}: cannot write there (no such directory, or no permission)")
+
+
+def samples_for(duration_s: float | None, rate_hz: float) -> int | None:
+    """Samples in ``duration_s`` at ``rate_hz`` (None: until Ctrl-C); a file needs at least 2."""
+    if duration_s is None:
+        return None
+    if not (math.isfinite(duration_s) and duration_s > 0):
+        raise UsageError(f"--duration must be a positive number of seconds, got {duration_s!r}")
+    n = int(round(duration_s * rate_hz))
+    if n < 2:
+        raise UsageError(f"--duration {duration_s:g} s holds fewer than 2 samples at {rate_hz:g} Hz "
+                         f"(a trajectory needs 2); give at least {2 / rate_hz:.3g} s")
+    return n
+
+
+def run_record(args) -> int:
+    from gaitbot.commands import _require_port
+
+    config = load_robot(args.robot)
+    out = Path(args.output)
+    _check_output(out)
+    rate_hz = config.gait.rate_hz
+    if args.dry_run and args.duration is None:
+        raise UsageError("--dry-run needs --duration (a dry run has no hand on the legs and no Ctrl-C to wait for)")
+    n_samples = samples_for(args.duration, rate_hz)
+    if args.reply_timeout_ms is not None and not (math.isfinite(args.reply_timeout_ms) and args.reply_timeout_ms > 0):
+        raise UsageError(f"--reply-timeout-ms must be a positive number of milliseconds, got {args.reply_timeout_ms!r}")
+    port = args.port or config.bus.port
+    if not args.dry_run:
+        _require_port(port)
+    bus = make_bus(config.bus.backend, config.bus.protocol, port, config.bus.baudrate, config.models_by_id,
+                   dry_run=args.dry_run, reply_timeout_ms=args.reply_timeout_ms)
+    bus = LimitGuard(bus, tick_limits(config), {j.id: j.name for j in config.joints})
+
+    def warn(text: str) -> None:
+        print(f"warning: {text}", file=sys.stderr)
+
+    sink = TrajectorySink(config, out, warn)
+    confirm = (lambda n: True) if args.yes else ask_torque_off
+    clock = VirtualClock() if args.dry_run else MonotonicClock()
+    if n_samples is None:
+        print(f"recording at {rate_hz:g} Hz until Ctrl-C", file=sys.stderr)
+    result = record_session(bus, config.ids, 1.0 / rate_hz, sink, confirm=confirm, n_samples=n_samples, clock=clock,
+                            hold_at_end=args.hold)
+    for note in getattr(bus, "open_notes", []):
+        print(f"note: {note}", file=sys.stderr)
+    for line in sink.limits.summary():
+        warn(line)
+    if result.outcome != "declined" and sink.writer is not None:
+        rows = sink.writer.rows
+        usable = "" if rows >= 2 else " (fewer than 2: not a readable trajectory)"
+        print(f"wrote {out}: {rows} samples{usable}, {rows / rate_hz:.2f} s at {rate_hz:g} Hz; root from foot "
+              f"contact, {sink.last_root_m[0]:.4f} m travelled")
+        print(result.timing.summary())
+    mode = "dry run (mock bus, simulated clock)" if args.dry_run else f"{config.bus.backend} on {port}"
+    print(f"{config.name}: {mode}. {result.message()}")
+    return result.exit_code
