@@ -82,7 +82,10 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--basis", choices=("fourier", "bspline"), default="fourier")
     q.add_argument("--n-basis", type=int, default=31, help="basis functions per channel (odd for fourier)")
     q.add_argument("--roughness", type=float, default=0.0, help="roughness penalty on the second derivative")
-    q.add_argument("--pose-variance", type=float, default=0.95, help="share of pose variance the pose PCA keeps")
+    q.add_argument("--pose-variance", type=float, default=0.95, help="share of pose variance the pose PCA keeps "
+                   "at least (default 0.95)")
+    q.add_argument("--pose-tolerance-deg", type=float, default=0.5, help="and more pose axes until no example pose "
+                   "moves by more than this when projected (default 0.5; inf: the variance rule alone)")
     q.add_argument("--variance", type=float, default=0.95, help="share of variance the eigen-motions kept explain")
     q.add_argument("--components", type=int, help="keep exactly this many eigen-motions")
     q.add_argument("--align", choices=("dtw", "none"), default="dtw", help="time alignment of the cycles")

@@ -13,15 +13,16 @@ first two steps, the synthesised cycles, the walker's closing step (see gait/eig
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
 
-from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, ExampleError, FitOptions, cycles_from_trajectory,
-                                fit_model, synthesize_walk, walk_label)
+from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, cycles_from_trajectory, fit_model,
+                                synthesize_walk, walk_label)
 from gaitbot.gait.trajectory import WALKING_JOINTS, Trajectory
 from gaitbot.robot.gait_setup import leg_geometry, walk_settings
-from gaitbot.session import UsageError, load_robot
+from gaitbot.session import UsageError, load_robot, preflight
 
 POSE_TOL_DEG = 0.1
 
@@ -30,17 +31,31 @@ def run_eigen(args) -> int:
     return {"fit": run_fit, "synth": run_synth}[args.eigen_command](args)
 
 
-def load_examples(paths, geometry):
-    """Example cycles of every file, each labelled with its walk's step length; and the frame rate."""
+#: Example files within this share of the robot's frame rate were sampled at it (CSV times carry
+#: 9 significant digits, so a 60 Hz file reads back as 60.0000001 Hz).
+RATE_TOL = 1e-6
+
+
+def load_examples(paths, geometry, robot_rate_hz: float | None = None, config=None):
+    """Example cycles of every file, each labelled with its walk's step length; and the frame rate
+    (the robot's own when the files were sampled at it). With ``config``, a file that breaks the
+    robot's limits (a recording a hand took too far) is learnt from, with a warning on stderr."""
     examples, rates = [], []
     for path in paths:
         trajectory = Trajectory.load(path)
+        if config is not None:
+            report = preflight(config, trajectory)
+            if not report.ok:
+                print(f"warning: {path}: {report.first_error}; it is learnt from as it is, but walks synthesised "
+                      f"near it may break the same limit, and gaitbot walk refuses those", file=sys.stderr)
         cycles = cycles_from_trajectory(trajectory, geometry, source=str(path))
         label = walk_label(cycles)
         examples += [c.__class__(c.angles_rad, c.duration_s, c.right_strike_phase, label, c.source) for c in cycles]
         rates.append(1.0 / float(np.median(np.diff(trajectory.t_s))))
-    if max(rates) - min(rates) > 1e-6 * max(rates):
+    if max(rates) - min(rates) > RATE_TOL * max(rates):
         raise UsageError(f"the example files have different frame rates ({min(rates):g} to {max(rates):g} Hz)")
+    if robot_rate_hz is not None and abs(rates[0] - robot_rate_hz) <= RATE_TOL * robot_rate_hz:
+        return examples, float(robot_rate_hz)
     return examples, rates[0]
 
 
@@ -51,23 +66,41 @@ def run_fit(args) -> int:
     config = load_robot(args.robot)
     geometry = leg_geometry(config)
     options = FitOptions(samples=args.samples, basis=args.basis, n_basis=args.n_basis, roughness=args.roughness,
-                         pose_variance=args.pose_variance, motion_variance=args.variance, components=args.components,
-                         align=args.align, label_degree=args.label_degree)
-    examples, rate = load_examples(args.examples, geometry)
+                         pose_variance=args.pose_variance, pose_tolerance_deg=args.pose_tolerance_deg,
+                         motion_variance=args.variance, components=args.components, align=args.align,
+                         label_degree=args.label_degree)
+    examples, rate = load_examples(args.examples, geometry, config.gait.rate_hz, config)
     model = fit_model(examples, geometry, rate, options, periodic=args.basis == "fourier")
     model.save(out)
     labels = sorted(set(np.round(model.labels, 6)))
     print(f"wrote {out}: {len(examples)} example cycles from {len(args.examples)} files, step lengths "
           f"{', '.join(f'{v:g}' for v in labels)} m")
-    pose_share = np.cumsum(model.pose_eigenvalues)[model.pose_dims - 1] / model.pose_eigenvalues.sum()
-    print(f"pose PCA: {model.pose_dims} of 6 axes keep {100 * pose_share:.2f}% of the pose variance")
-    print("eigen-motion  variance %  cumulative %")
+    print_pose_pca(model, options)
+    print_variance_table("eigen-motion", model.variance_explained, model.n_components)
     cumulative = np.cumsum(model.variance_explained)
-    for i, (share, total) in enumerate(zip(model.variance_explained, cumulative), start=1):
-        mark = "  kept" if i <= model.n_components else ""
-        print(f"{i:12d}  {100 * share:10.3f}  {100 * total:12.3f}{mark}")
     print(f"{model.n_components} eigen-motions kept ({100 * cumulative[model.n_components - 1]:.2f}% of the variance)")
     return 0
+
+
+def print_variance_table(what: str, shares: np.ndarray, kept: int) -> None:
+    """Variance explained per component (percent) and cumulative, the kept ones marked."""
+    print(f"{what:>12}  variance %  cumulative %")
+    for i, (share, total) in enumerate(zip(shares, np.cumsum(shares)), start=1):
+        print(f"{i:12d}  {100 * share:10.3f}  {100 * total:12.3f}{'  kept' if i <= kept else ''}")
+
+
+def print_pose_pca(model: EigenGaitModel, options: FitOptions) -> None:
+    shares = model.pose_eigenvalues / model.pose_eigenvalues.sum()
+    print_variance_table("pose axis", shares, model.pose_dims)
+    d, by_variance, residuals = model.pose_dims, model.pose_variance_dims, model.pose_residuals_deg
+    kept = 100 * shares[:d].sum()
+    line = (f"pose PCA: {d} of {len(shares)} axes kept ({kept:.2f}% of the pose variance; the examples' poses "
+            f"move by at most {residuals[d - 1]:.3f} deg when projected on them)")
+    if d > by_variance:
+        line += (f"; {100 * options.pose_variance:g}% of the variance needs only {by_variance}, which would move a "
+                 f"joint by up to {residuals[by_variance - 1]:.2f} deg, more than --pose-tolerance-deg "
+                 f"{options.pose_tolerance_deg:g}")
+    print(line)
 
 
 def _parse_pose(text: str) -> np.ndarray:
@@ -132,7 +165,8 @@ def run_synth(args) -> int:
             j = int(np.argmax(np.abs(miss)))
             raise EigenModelError(f"--pose-deg cannot be reached: the model's {len(alpha)} eigen-motions and "
                                   f"{model.pose_dims} pose axes miss {WALKING_JOINTS[j]} by {worst:.3g} deg "
-                                  f"(try --components up to {len(model.eigenvalues)}, or fit with --pose-variance 1)")
+                                  f"(try --components up to {len(model.eigenvalues)}, or fit with a smaller "
+                                  f"--pose-tolerance-deg)")
         alphas = [alpha] * (args.cycles + 1)
         pose_report = (args.pose_time, worst)
     walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,

@@ -15,7 +15,10 @@ model (contact.py, gait-model.md section 3), so such motions obey the same groun
   ``tol`` above the other foot's; its heel strike is the first frame after that at which it is
   back within a tenth of ``tol`` of the other foot's level. Only the *difference* of the two feet's
   heights matters, so heights relative to the hip (no root known), above flat ground, or each above
-  the terrain under it all give the same strikes on flat ground.
+  the terrain under it all give the same strikes on flat ground. ``detect_heel_strikes`` applies it
+  to a trajectory (``gaitbot eigen fit`` cuts cycles with it; ``gaitbot plot`` marks strikes with it).
+- ``swing_clearances``: the walker's clearance rule measured on any flat-ground trajectory, so
+  synthesised or recorded walks can be compared with the walker's.
 """
 
 from __future__ import annotations
@@ -23,8 +26,9 @@ from __future__ import annotations
 import numpy as np
 
 from .contact import ankle_in_body, grounded_ankle, leg_pitch, lowest_sole_y
-from .geometry import LegGeometry, ankle_position
-from .trajectory import HeelStrike
+from .geometry import LegGeometry, ankle_position, leg_points
+from .segments import CLEARANCE_WINDOW
+from .trajectory import HeelStrike, Trajectory
 
 #: Contact tolerance as a share of the leg length: 2.2 mm for the 0.22 m leg of the shipped robots.
 CONTACT_TOL_FRACTION = 0.01
@@ -56,6 +60,24 @@ def heel_strikes_from_heights(t_s, heights_m, heel_x_m, tol_m: float) -> list[He
                 strikes.append(HeelStrike(float(t_s[k]), leg, float(heel_x_m[k, side])))
                 airborne = False
     return sorted(strikes, key=lambda h: h.t_s)
+
+
+def heel_world_x(geometry: LegGeometry, trajectory: Trajectory) -> np.ndarray:
+    """(N, 2) world x of the left and right heel."""
+    out = []
+    for side in (0, 1):
+        q = trajectory.angles_rad[:, 3 * side:3 * side + 3]
+        _, _, heel, _ = leg_points(geometry, q[:, 0], q[:, 1], q[:, 2])
+        out.append(heel[:, 0] + trajectory.root_m[:, 0])
+    return np.column_stack(out)
+
+
+def detect_heel_strikes(trajectory: Trajectory, geometry: LegGeometry, contact_tol_m: float | None = None):
+    """Heel strikes from foot contact (for files without them): list of HeelStrike. Feet heights are
+    taken relative to the hip, so a file without a root still gives their times."""
+    tol = CONTACT_TOL_FRACTION * geometry.leg_length if contact_tol_m is None else contact_tol_m
+    return heel_strikes_from_heights(trajectory.t_s, foot_heights_in_body(geometry, trajectory.angles_rad),
+                                     heel_world_x(geometry, trajectory), tol)
 
 
 class ContactRoot:
@@ -110,3 +132,31 @@ def root_from_contact(geometry: LegGeometry, angles_rad, start_root, land_tol: f
         root[k] = tracker.update(q)
         stance[k] = tracker.stance
     return root, stance
+
+
+def swing_clearances(geometry: LegGeometry, trajectory, tol_m: float | None = None) -> list[tuple[HeelStrike, float]]:
+    """Per heel strike: the least height of the whole swing sole above flat ground from 20% to 80% of
+    the swing that ends in it (the walker's clearance rule, segments.CLEARANCE_WINDOW).
+
+    The swing runs from the last frame the foot was within ``tol_m`` (default CONTACT_TOL_FRACTION of
+    the leg) of the ground to the frame before it is back; heights use the trajectory's root, so the
+    walker's walks and walks with a root from contact are measured alike. Heel strikes are the file's,
+    else detected (``detect_heel_strikes``); strikes with no airborne frames before them are skipped."""
+    tol = CONTACT_TOL_FRACTION * geometry.leg_length if tol_m is None else tol_m
+    heights = foot_heights_in_body(geometry, trajectory.angles_rad) + trajectory.root_m[:, 1:2]
+    out = []
+    for strike in trajectory.heel_strikes or detect_heel_strikes(trajectory, geometry):
+        side = 0 if strike.leg == "left" else 1
+        end = int(np.argmin(np.abs(trajectory.t_s - strike.t_s)))
+        while end > 0 and heights[end, side] <= tol:
+            end -= 1
+        start = end
+        while start > 0 and heights[start - 1, side] > tol:
+            start -= 1
+        if end <= start:
+            continue
+        lo, hi = start + CLEARANCE_WINDOW[0] * (end - start), start + CLEARANCE_WINDOW[1] * (end - start)
+        window = np.arange(int(np.ceil(lo)), int(np.floor(hi)) + 1)
+        if len(window):
+            out.append((strike, float(heights[window, side].min())))
+    return out

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..footfall import CONTACT_TOL_FRACTION, foot_heights_in_body, heel_strikes_from_heights
-from ..geometry import LegGeometry, leg_points
+from ..footfall import CONTACT_TOL_FRACTION, detect_heel_strikes, foot_heights_in_body, heel_world_x
+from ..geometry import LegGeometry
 from ..trajectory import Trajectory
 
 __all__ = ["CONTACT_TOL_FRACTION", "ExampleCycle", "ExampleError", "cycles_from_trajectory", "detect_heel_strikes",
@@ -41,24 +41,6 @@ class ExampleCycle:
     right_strike_phase: float
     step_length_m: float
     source: str = ""
-
-
-def heel_world_x(geometry: LegGeometry, trajectory: Trajectory) -> np.ndarray:
-    """(N, 2) world x of the left and right heel."""
-    out = []
-    for side in (0, 1):
-        q = trajectory.angles_rad[:, 3 * side:3 * side + 3]
-        _, _, heel, _ = leg_points(geometry, q[:, 0], q[:, 1], q[:, 2])
-        out.append(heel[:, 0] + trajectory.root_m[:, 0])
-    return np.column_stack(out)
-
-
-def detect_heel_strikes(trajectory: Trajectory, geometry: LegGeometry, contact_tol_m: float | None = None):
-    """Heel strikes from foot contact (for files without them): list of HeelStrike (footfall.py's rule,
-    with feet heights relative to the hip, so a file without a root still gives their times)."""
-    tol = CONTACT_TOL_FRACTION * geometry.leg_length if contact_tol_m is None else contact_tol_m
-    return heel_strikes_from_heights(trajectory.t_s, foot_heights_in_body(geometry, trajectory.angles_rad),
-                                     heel_world_x(geometry, trajectory), tol)
 
 
 def _frame_of(trajectory: Trajectory, t_s: float) -> int:

@@ -4,7 +4,8 @@ Fit (``fit_model``), following seed 004:
 1. each cycle is resampled to ``samples`` frames (section 3 (2)) and DTW-aligned to a reference,
    the example whose label is the median (section 3 (1)); the warps are kept (see align.py);
 2. PCA of all aligned poses; the leading axes U explaining ``pose_variance`` (default 95%) are
-   kept (eq. 1);
+   kept (eq. 1), and more until no example pose moves by more than ``pose_tolerance_deg``
+   (default 0.5 deg) when projected on them (pose.py says why);
 3. each reduced channel of each example is fitted by penalised least squares in a Fourier basis
    (periodic cycles) or a B-spline basis (section 4.1, eq. 3);
 4. functional PCA of the coefficient vectors: ``N^-1 C^T C W b = lambda b`` (eq. 10), W the
@@ -33,6 +34,7 @@ from ..geometry import LegGeometry
 from .align import align_to_reference, resample_cycle, sample_phases
 from .basis import fit_coefficients, make_basis
 from .examples import ExampleCycle
+from .pose import leading_count, pose_pca
 
 MODEL_KIND = "gaitbot-eigen-gait"
 MODEL_VERSION = 1
@@ -49,6 +51,7 @@ class FitOptions:
     n_basis: int = 31
     roughness: float = 0.0
     pose_variance: float = 0.95
+    pose_tolerance_deg: float = 0.5  # inf: the paper's variance rule alone
     motion_variance: float = 0.95
     components: int | None = None  # fixed number of eigen-motions (overrides motion_variance)
     align: str = "dtw"  # or "none"
@@ -68,6 +71,8 @@ class FitOptions:
             v = getattr(self, name)
             if not (0.0 < v <= 1.0):
                 raise EigenModelError(f"{name} must be in (0, 1], got {v}")
+        if not self.pose_tolerance_deg >= 0:
+            raise EigenModelError(f"pose_tolerance_deg must be 0 or more degrees (inf: none), got {self.pose_tolerance_deg}")
         if self.roughness < 0:
             raise EigenModelError(f"roughness must be 0 or more, got {self.roughness}")
         if self.align not in ("dtw", "none"):
@@ -101,6 +106,8 @@ class EigenGaitModel:
     geometry: LegGeometry
     rate_hz: float
     sources: tuple = field(default_factory=tuple)
+    pose_variance_dims: int = 0  # pose axes the variance rule alone would keep (0: not recorded)
+    pose_residuals_deg: np.ndarray | None = None  # (6,) largest joint error of the examples with 1..6 pose axes
 
     # -- basic evaluation -------------------------------------------------------------------
     @property
@@ -190,7 +197,9 @@ class EigenGaitModel:
                  scores=self.scores, labels=self.labels, warp_coefs=self.warp_coefs, durations_s=self.durations_s,
                  right_strike_phases=self.right_strike_phases, label_degree=self.label_degree,
                  geometry=np.array([g.thigh, g.shank, g.foot, g.hip_width, g.ankle_height, g.heel_back]),
-                 rate_hz=self.rate_hz, sources=np.array([str(s) for s in self.sources], dtype=str))
+                 rate_hz=self.rate_hz, sources=np.array([str(s) for s in self.sources], dtype=str),
+                 pose_variance_dims=self.pose_variance_dims,
+                 pose_residuals_deg=np.full(0, np.nan) if self.pose_residuals_deg is None else self.pose_residuals_deg)
 
     @classmethod
     def load(cls, path: str | Path) -> "EigenGaitModel":
@@ -213,7 +222,8 @@ class EigenGaitModel:
                    float(d["roughness"]), d["pose_mean"], d["pose_axes"], d["pose_eigenvalues"], d["coef_mean"],
                    d["eigen_coefs"], d["eigenvalues"], int(d["n_components"]), d["scores"], d["labels"],
                    d["warp_coefs"], d["durations_s"], d["right_strike_phases"], int(d["label_degree"]),
-                   LegGeometry(*map(float, g)), float(d["rate_hz"]), tuple(str(s) for s in d["sources"]))
+                   LegGeometry(*map(float, g)), float(d["rate_hz"]), tuple(str(s) for s in d["sources"]),
+                   int(d.get("pose_variance_dims", 0)), d.get("pose_residuals_deg"))
 
 
 def is_model_file(path: str | Path) -> bool:
@@ -223,15 +233,6 @@ def is_model_file(path: str | Path) -> bool:
             return "kind" in z.files and str(z["kind"]) == MODEL_KIND
     except Exception:
         return False
-
-
-def _leading(eigenvalues: np.ndarray, share: float) -> int:
-    """Smallest count whose eigenvalues hold more than ``share`` of the total (eq. 11)."""
-    total = eigenvalues.sum()
-    if total <= 0:
-        return 1
-    cumulative = np.cumsum(eigenvalues) / total
-    return int(min(len(eigenvalues), np.searchsorted(cumulative, share - 1e-12, side="right") + 1))
 
 
 def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: float,
@@ -261,14 +262,9 @@ def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: floa
         warps.append(h)
     aligned = np.array(aligned)  # (N, S, 6)
 
-    # pose PCA (eq. 1)
-    flat = aligned.reshape(-1, aligned.shape[-1])
-    pose_mean = flat.mean(axis=0)
-    pose_eig, pose_vec = np.linalg.eigh(np.cov((flat - pose_mean).T, bias=True))
-    order = np.argsort(pose_eig)[::-1]
-    pose_eig, pose_vec = np.clip(pose_eig[order], 0.0, None), pose_vec[:, order]
-    d = _leading(pose_eig, options.pose_variance)
-    axes = pose_vec[:, :d]
+    # pose PCA (eq. 1; pose.py)
+    pose = pose_pca(aligned.reshape(-1, aligned.shape[-1]), options.pose_variance, options.pose_tolerance_deg)
+    d, axes, pose_mean = pose.dims, pose.axes, pose.mean
     reduced = (aligned - pose_mean) @ axes  # (N, S, d)
 
     # functional representation (eq. 3, with the roughness penalty)
@@ -296,9 +292,11 @@ def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: floa
                                   f"in only {len(eigenvalues)} independent ways")
         m = options.components
     else:
-        m = _leading(eigenvalues, options.motion_variance)
-    return EigenGaitModel(options.basis, K, options.samples, periodic, options.roughness, pose_mean, axes, pose_eig,
+        m = leading_count(eigenvalues, options.motion_variance)
+    return EigenGaitModel(options.basis, K, options.samples, periodic, options.roughness, pose_mean, axes,
+                          pose.eigenvalues,
                           coef_mean, b.reshape(-1, d, K), eigenvalues, m, scores, labels, warp_coefs,
                           np.array([e.duration_s for e in examples]),
                           np.array([e.right_strike_phase for e in examples]), options.label_degree, geometry,
-                          float(rate_hz), tuple(sorted({e.source for e in examples})))
+                          float(rate_hz), tuple(sorted({e.source for e in examples})), pose.variance_dims,
+                          pose.residuals_deg)
