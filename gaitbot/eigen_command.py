@@ -2,12 +2,16 @@
 
 fit: each EXAMPLE is a trajectory file (.npz with heel strikes, or .csv whose heel strikes are
 found from foot contact with the robot's leg); its steady cycles are examples, labelled with the
-walk's step length. Prints the variance explained per eigen-motion.
+walk's step length. Prints the variance explained per pose axis and per eigen-motion (pose.py
+says how many pose axes are kept and why); warns about example files that break the robot's limits.
 
 synth: a walk at ``--step-length`` (optionally going to ``--to-step-length``), written in the
 trajectory format; optionally forced through ``--pose-deg`` at ``--pose-time`` seconds into each
 synthesised cycle (seed 004 eq. 13). The walk starts standing and ends standing: the walker's
 first two steps, the synthesised cycles, the walker's closing step (see gait/eigen/synth.py).
+The walk is checked as ``gaitbot walk`` would check it: one that breaks a limit (a forced pose far
+from the examples' at that time can distort the whole cycle) is still written, for plotting, but a
+warning says so and the exit status is 1.
 """
 
 from __future__ import annotations
@@ -163,10 +167,11 @@ def run_synth(args) -> int:
         worst = float(np.degrees(np.abs(miss)).max())
         if worst > POSE_TOL_DEG:
             j = int(np.argmax(np.abs(miss)))
+            hint = f"try --components up to {len(model.eigenvalues)}"
+            if model.pose_dims < len(WALKING_JOINTS):
+                hint += ", or fit with a smaller --pose-tolerance-deg (more pose axes)"
             raise EigenModelError(f"--pose-deg cannot be reached: the model's {len(alpha)} eigen-motions and "
-                                  f"{model.pose_dims} pose axes miss {WALKING_JOINTS[j]} by {worst:.3g} deg "
-                                  f"(try --components up to {len(model.eigenvalues)}, or fit with a smaller "
-                                  f"--pose-tolerance-deg)")
+                                  f"{model.pose_dims} pose axes miss {WALKING_JOINTS[j]} by {worst:.3g} deg ({hint})")
         alphas = [alpha] * (args.cycles + 1)
         pose_report = (args.pose_time, worst)
     walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,
@@ -179,4 +184,10 @@ def run_synth(args) -> int:
         starts = [h.t_s for h in walk.heel_strikes if h.leg == "left"][:args.cycles]
         times = ", ".join(f"{t + pose_report[0]:.3f}" for t in starts)
         print(f"pose reached to {pose_report[1]:.3g} deg at t = {times} s")
+    report = preflight(config, walk)
+    if not report.ok:
+        # a forced pose far from the examples' poses at that time can take every other frame far off
+        print(f"warning: {out} breaks {config.name}'s limits ({report.first_error}); gaitbot walk would refuse it. "
+              f"Ask for a pose nearer the examples' at that time, or fewer --components", file=sys.stderr)
+        return 1
     return 0

@@ -374,18 +374,36 @@ def test_cli_fit_synth_check_plot(files, capsys):
 
 
 def test_cli_pose_constraint(files, capsys):
+    """The pose a 0.065 m walk takes 0.567 s after a left heel strike, forced on a 0.05 m walk at that time."""
     d, paths = files
     model = str(d / "model_default.npz")
     assert main(["eigen", "fit", *paths, "-o", model]) == 0
     out_npz = str(d / "posed.npz")
-    pose = np.degrees(walk(0.065).angles_rad[400])
+    source = walk(0.065)
+    k = int(np.argmin(np.abs(source.t_s - (source.heel_strikes[3].t_s + 0.567))))
+    pose = np.degrees(source.angles_rad[k])
     arg = ",".join(f"{v:.6f}" for v in pose)
     assert main(["eigen", "synth", model, "--step-length", "0.05", "--components", "7", "--pose-deg", arg,
-                 "--pose-time", "1.0", "-o", out_npz]) == 0
+                 "--pose-time", "0.567", "-o", out_npz]) == 0
     tr = Trajectory.load(out_npz)
     lefts = [h.t_s for h in tr.heel_strikes if h.leg == "left"]
-    k = int(np.argmin(np.abs(tr.t_s - (lefts[1] + 1.0))))  # the middle cycle, away from the joins
-    assert np.abs(tr.angles_deg[k] - pose).max() < 0.1
+    for start in lefts[:3]:  # every synthesised cycle passes through the pose at its requested time
+        k = int(np.argmin(np.abs(tr.t_s - (start + 0.567))))
+        assert abs(tr.t_s[k] - (start + 0.567)) < 0.5 / SETTINGS.rate_hz
+        assert np.abs(tr.angles_deg[k] - pose).max() < 0.1
+    assert np.abs(steady_step_lengths(tr) - 0.065).max() < 0.005  # the pose brings its step length along
+
+
+def test_cli_a_forced_pose_that_distorts_the_walk_is_written_but_flagged(files, tmp_path, capsys):
+    d, paths = files
+    model = str(tmp_path / "m.npz")
+    assert main(["eigen", "fit", *paths, "-o", model]) == 0
+    pose = np.degrees(walk(0.065).angles_rad[400])  # a mid-swing pose asked for at the wrong moment
+    out = tmp_path / "bent.csv"
+    assert main(["eigen", "synth", model, "--step-length", "0.05", "--components", "7", "--pose-deg",
+                 ",".join(f"{v:.6f}" for v in pose), "--pose-time", "1.0", "-o", str(out)]) == 1
+    assert "gaitbot walk would refuse it" in capsys.readouterr().err
+    assert main(["check", str(out)]) == 1
 
 
 def test_cli_errors_exit_2(files, tmp_path, capsys):

@@ -215,3 +215,62 @@ def test_cli_prints_the_device_path_first_and_the_pty_answers(tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=5)
+
+
+# --- the scripted hand (gaitbot record's test partner) ------------------------------------------
+
+def present_of(replies, framing="v2"):
+    return {wire.parse(r, framing, status=True).packet_id: int.from_bytes(
+        bytes(wire.parse(r, framing, status=True).params), "little", signed=framing == "v2") for r in replies}
+
+
+def test_the_hand_moves_servos_with_torque_off_one_sample_per_sync_read_cycle():
+    hand = se.Hand({1: [2100, 2200, 2300], 2: [1900, 1800, 1700]})
+    c = chain("dynamixel", 2.0, XL430, ids=(1, 2), hand=hand)
+    sync_read = wire.build_v2(0xFE, wire.INST_SYNC_READ, bytes([132, 0, 4, 0, 1, 2]))
+    assert present_of(ask(c, sync_read, 1.0)) == {1: 2048, 2: 2048}  # not grabbed before a torque-off
+    ask(c, wire.build_v2(1, wire.INST_WRITE, bytes([64, 0, 0])), 2.0)  # torque off servo 1: the hand takes over
+    got = [present_of(ask(c, sync_read, 3.0 + k)) for k in range(4)]
+    assert got == [{1: 2100, 2: 1900}, {1: 2200, 2: 1800}, {1: 2300, 2: 1700}, {1: 2300, 2: 1700}]  # then holds
+
+
+def test_the_hand_counts_one_read_per_servo_as_one_cycle_and_leaves_torqued_servos_alone():
+    hand = se.Hand({1: [600, 610, 620], 2: [400, 390, 380]})
+    c = chain("dynamixel", 1.0, AX12, ids=(1, 2), hand=hand)
+    ask(c, wire.build_v1(1, wire.INST_WRITE, bytes([24, 0])), 1.0)  # torque off (already off: still a grab)
+    ask(c, wire.build_v1(2, wire.INST_WRITE, bytes([24, 1])), 1.0)  # torque on servo 2: it holds its goal
+    read = [wire.build_v1(i, wire.INST_READ, bytes([36, 2])) for i in (1, 2)]
+    seen = []
+    for k in range(3):
+        row = {}
+        for packet in read:
+            row.update(present_of(ask(c, packet, 2.0 + k), "v1"))
+        seen.append(row)
+    assert [r[1] for r in seen] == [600, 610, 620]
+    assert [r[2] for r in seen] == [512, 512, 512]  # torque on: the hand cannot move it
+
+
+def test_a_hand_with_a_rate_follows_time_from_the_torque_off():
+    c = chain("dynamixel", 2.0, XL430, ids=(1,), hand=se.Hand({1: list(range(2000, 2100))}, rate_hz=10.0))
+    ask(c, wire.build_v2(1, wire.INST_WRITE, bytes([64, 0, 0])), 5.0)
+    read = wire.build_v2(1, wire.INST_READ, bytes([132, 0, 4, 0]))
+    assert present_of(ask(c, read, 5.35)) == {1: 2003}
+    assert present_of(ask(c, read, 5.35)) == {1: 2003}  # time, not reads, moves it
+    assert present_of(ask(c, read, 7.0)) == {1: 2020}
+
+
+def test_hand_from_a_trajectory_file_on_the_command_line(tmp_path):
+    from gaitbot.gait import generate_walk
+    from gaitbot.robot.config import load_robot_config, resolve_config
+    from gaitbot.robot.gait_setup import leg_geometry, walk_settings
+
+    robot = load_robot_config(resolve_config("xl430-biped"))
+    walk = generate_walk(leg_geometry(robot), [0.05, 0.05], walk_settings(robot))
+    path = tmp_path / "hand.csv"
+    walk.save(path)
+    config = se.config_from_args(se.build_parser().parse_args(["--robot", "xl430-biped", "--hand", str(path)]))
+    assert config.hand.samples == len(walk) and config.hand.rate_hz is None
+    # right hip (id 4) is mirror-mounted: ticks = 2048 - deg * 4096 / 360
+    assert config.hand.ticks[4][200] == round(2048 - walk.angles_deg[200, 3] * 4096 / 360)
+    with pytest.raises(ValueError, match="needs --robot"):
+        se.config_from_args(se.build_parser().parse_args(["--protocol", "dxl2", "--hand", str(path)]))
