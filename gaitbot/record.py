@@ -18,7 +18,8 @@ moves the legs):
 * completed (exit 0): ``n_samples`` read;
 * stopped (exit 0): Ctrl-C, the usual way to end a recording without ``n_samples``;
 * terminated (exit 143): SIGTERM;
-* bus_error (exit 1): a servo stops answering, reports an error, or the port disappears.
+* bus_error (exit 1): a servo stops answering, reports an error, or the port disappears;
+* file_error (exit 1): the sink cannot write (a full disk); the rows before are in the file.
 
 Torque stays off at every exit (the person holding the legs keeps them). With ``hold_at_end``,
 after a completed, stopped or terminated recording the pose is held instead: present positions
@@ -44,7 +45,7 @@ from gaitbot.stream import EXIT_CODES, LATE_THRESHOLD_S, Terminated, paced_deadl
 
 #: Exit status of each outcome: a stopped recording (Ctrl-C) is a normal end.
 RECORD_EXIT_CODES = {"declined": 0, "completed": 0, "stopped": 0, "terminated": EXIT_CODES["terminated"],
-                     "bus_error": EXIT_CODES["bus_error"]}
+                     "bus_error": EXIT_CODES["bus_error"], "file_error": 1}
 #: fsync the sink about once a second (every row is flushed to the OS as it is written anyway).
 SYNC_EVERY_S = 1.0
 
@@ -101,7 +102,8 @@ class RecordResult:
     def message(self) -> str:
         head = {"declined": "Recording cancelled: nothing was sent, torque left as it was",
                 "completed": "Recording completed", "stopped": "Recording stopped (Ctrl-C)",
-                "terminated": "Recording terminated (SIGTERM)", "bus_error": "Recording stopped by a bus error"}
+                "terminated": "Recording terminated (SIGTERM)", "bus_error": "Recording stopped by a bus error",
+                "file_error": "Recording stopped: the file could not be written"}
         parts = [head[self.outcome]]
         if self.error is not None:
             parts.append(f"error: {self.error}")
@@ -144,13 +146,18 @@ def record_session(bus: Bus, ids: Sequence[int], period_s: float, sink: SampleSi
                 outcome = "terminated"
             except BusError as exc:
                 outcome, error = "bus_error", exc
-            if hold_at_end and outcome != "bus_error" and state["torque"] == "off":
+            except OSError as exc:  # the sink's file; the bus's own OS errors arrive as PortError
+                outcome, error = "file_error", exc
+            if hold_at_end and outcome in ("completed", "stopped", "terminated") and state["torque"] == "off":
                 state["torque"] = _hold_present_pose(bus, ids, notes)
             elif state["torque"] == "off":
                 notes.append("torque stays off")
         finally:
             if state["sink_open"]:
-                sink.close()
+                try:
+                    sink.close()
+                except OSError as exc:
+                    notes.append(f"closing the file failed: {exc}")
             if state["opened"]:
                 try:
                     bus.close()

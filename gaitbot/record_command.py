@@ -67,9 +67,10 @@ class LimitWatch:
 class TrajectorySink:
     """Samples of ticks (the config's joint order) -> rows of a trajectory CSV (see the module docstring)."""
 
-    def __init__(self, config: RobotConfig, path: Path, warn) -> None:
+    def __init__(self, config: RobotConfig, path: Path, warn, status=None) -> None:
         self.config = config
         self.path = path
+        self.status = status  # called with (samples, t_s) after each sample, for a live status line
         self.limits = LimitWatch(config, warn)
         self.writer: CsvTrajectoryWriter | None = None
         self.root: ContactRoot | None = None
@@ -84,6 +85,8 @@ class TrajectorySink:
         self.last_root_m = self.root.update(angles_rad[:6])
         self.writer.write(t_s, angles_rad[:6], self.last_root_m)
         self.limits.see(t_s, np.degrees(angles_rad))
+        if self.status is not None:
+            self.status(self.writer.rows, t_s)
 
     def sync(self) -> None:
         self.writer.sync()
@@ -126,6 +129,20 @@ def samples_for(duration_s: float | None, rate_hz: float) -> int | None:
     return n
 
 
+def _status_line(rate_hz: float):
+    """On a terminal, the samples so far, rewritten in place twice a second; else nothing."""
+    if not sys.stderr.isatty():
+        return None
+    every = max(1, int(rate_hz / 2))
+
+    def show(samples: int, t_s: float) -> None:
+        if samples % every == 0:
+            sys.stderr.write(f"\rrecording: {samples} samples, {t_s:.1f} s (Ctrl-C to stop)   ")
+            sys.stderr.flush()
+
+    return show
+
+
 def run_record(args) -> int:
     from gaitbot.commands import _require_port
 
@@ -148,13 +165,15 @@ def run_record(args) -> int:
     def warn(text: str) -> None:
         print(f"warning: {text}", file=sys.stderr)
 
-    sink = TrajectorySink(config, out, warn)
+    sink = TrajectorySink(config, out, warn, _status_line(rate_hz))
     confirm = (lambda n: True) if args.yes else ask_torque_off
     clock = VirtualClock() if args.dry_run else MonotonicClock()
     if n_samples is None:
         print(f"recording at {rate_hz:g} Hz until Ctrl-C", file=sys.stderr)
     result = record_session(bus, config.ids, 1.0 / rate_hz, sink, confirm=confirm, n_samples=n_samples, clock=clock,
                             hold_at_end=args.hold)
+    if sink.status is not None and sink.writer is not None:
+        sys.stderr.write("\n")
     for note in getattr(bus, "open_notes", []):
         print(f"note: {note}", file=sys.stderr)
     for line in sink.limits.summary():

@@ -280,3 +280,21 @@ def test_cli_bad_input_is_one_line_exit_2(tmp_path, capsys, args, words):
 def test_cli_real_port_that_does_not_exist_is_bad_input(tmp_path, capsys):
     assert main(["record", "--yes", "--port", str(tmp_path / "ttyNONE"), "-o", str(tmp_path / "d.csv")]) == 2
     assert "no such serial port" in capsys.readouterr().err
+
+
+def test_a_file_that_cannot_be_written_any_more_stops_with_exit_1_and_torque_off(tmp_path):
+    bus = guarded_mock_bus()
+
+    class FullDisk(HandSink):
+        def add(self, t_s, ticks):
+            if self.k == 25:
+                raise OSError(28, "No space left on device")
+            super().add(t_s, ticks)
+
+    out = tmp_path / "d.csv"
+    result = record_session(bus, IDS, PERIOD_S, FullDisk(out, bus, hand_ticks(50)), confirm=lambda n: True,
+                            n_samples=50, clock=VirtualClock(), hold_at_end=True)
+    assert (result.outcome, result.exit_code, result.torque) == ("file_error", 1, "off")
+    assert "No space left" in result.message()
+    assert torque_writes(bus) == [(i, 0) for i in IDS]  # no hold after a failure
+    assert len(Trajectory.load(out)) == 25
