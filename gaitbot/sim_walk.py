@@ -35,7 +35,9 @@ def check_sim_arguments(args) -> None:
                "port": "a simulated walk has no serial port",
                "realtime": "a simulated walk runs on the simulated clock, as fast as the CPU allows",
                "terrain": "the simulated floor is flat; terrain courses are not simulated yet",
-               "reply_timeout_ms": "a simulated walk has no serial port"}
+               "reply_timeout_ms": "a simulated walk has no serial port",
+               **{leg: "the simulated robot is built from the robot config: give the leg in a config file"
+                  for leg in ("thigh", "shank", "foot")}}
     for flag, why in refused.items():
         if getattr(args, flag, None):
             raise UsageError(f"--{flag.replace('_', '-')}: {why}")

@@ -8,7 +8,7 @@ Definitions (the README repeats them):
 
 distance_planned_m / distance_travelled_m
     Forward displacement of the hip point (the torso on its boom): planned by the gait, and
-    measured from the first to the last sample of the run.
+    measured from the start (standing, before the first goal) to the last sample of the run.
 fell, fell_at_s, fall_reason
     The first sample at which a part other than a sole touches the floor, the hip is below
     FALL_HEIGHT_SHARE of its standing height, or the torso leans more than FALL_PITCH_DEG (free
@@ -20,8 +20,9 @@ max_slip_m
     that rolls over its heel or toe without sliding adds nothing; a sliding or creeping one does.
 scuff_fraction
     Over the planned swings' clearance windows (the part of each swing where the gait promises the
-    configured clearance), the share of time the swinging sole touches the floor (timed per
-    physics step).
+    configured clearance), the share of time the swinging sole touches the floor: contact is timed
+    per physics step within each frame, and a frame that only partly overlaps a window counts in
+    proportion to the overlap.
 max_torque_fraction
     The largest |torque asked of a servo| / its stall torque over the run, per physics step
     (1.0: the servo is saturated at least once).
@@ -101,7 +102,7 @@ class WalkMeter:
 
     def __init__(self, robot: SimRobot) -> None:
         self.robot = robot
-        self.standing_hip_m = float(robot.torso_position_m()[1])
+        self.start_x_m, self.standing_hip_m = (float(v) for v in robot.torso_position_m())
         self.times_s: list[float] = []
         self.torso_x_m: list[float] = []
         self.touch_share: list[np.ndarray] = []
@@ -168,7 +169,7 @@ class WalkMeter:
 
     def report(self, plan: WalkPlan, free_pitch: bool) -> SimReport:
         times = np.array(self.times_s)
-        travelled = self.torso_x_m[-1] - self.torso_x_m[0] if self.torso_x_m else 0.0
+        travelled = self.torso_x_m[-1] - self.start_x_m if self.torso_x_m else 0.0
         return SimReport(
             distance_planned_m=float(plan.distance_m), distance_travelled_m=float(travelled),
             fell=self.fell_at_s is not None, fell_at_s=self.fell_at_s, fall_reason=self.fall_reason,

@@ -5,9 +5,10 @@ lets it move forward (slide x) and up and down (slide z); its pitch is held (no 
 ``free_pitch``, which adds a free hinge. Both legs hang from the torso, hip_width apart, and only
 touch the floor, never each other.
 
-Legs (``[geometry]``, the gait's own LegGeometry, so the feet are where the gait thinks they are):
-thigh and shank capsules, and a foot whose sole is a box from the heel (heel_back behind the
-ankle) to the toe (foot_m ahead of the heel), its underside ankle_height below the ankle axis.
+Legs (``[geometry]``, the numbers the gait's LegGeometry is made of, so the feet are where the gait
+thinks they are): thigh and shank capsules, and a foot whose sole is a box from the heel
+(heel_back_m behind the ankle) to the toe (foot_m ahead of the heel), its underside ankle_height_m
+below the ankle axis. (The bus room reads the robot config only, never the gait room.)
 Hinge axes follow the flexion-positive convention: hip and ankle about -y, knee about +y.
 
 Masses (``[mass]``): torso, thigh, shank, foot; inertias follow from each link's shape as a
@@ -41,9 +42,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from gaitbot.gait.geometry import LegGeometry
-from gaitbot.robot.config import RobotConfig
-from gaitbot.robot.gait_setup import leg_geometry
+from gaitbot.robot.config import Geometry, RobotConfig
 
 MAX_TIMESTEP_S = 0.001
 CONTACT_SOLREF = (0.004, 1.0)
@@ -110,13 +109,12 @@ def _f(*values: float) -> str:
     return " ".join(f"{v:.6g}" for v in values)
 
 
-def _leg(side: str, y_m: float, g: LegGeometry, config: RobotConfig, drives: dict[str, JointDrive]) -> str:
+def _leg(side: str, y_m: float, g: Geometry, config: RobotConfig, drives: dict[str, JointDrive]) -> str:
     mass = config.mass
-    radius = 0.1 * g.leg_length / 2
-    sole_length = g.heel_back + g.toe_forward
-    sole_centre_x = (g.toe_forward - g.heel_back) / 2
-    sole_centre_z = -g.ankle_height + SOLE_THICKNESS_M / 2
-    sole_half = (sole_length / 2, max(g.hip_width / 4, 0.01), SOLE_THICKNESS_M / 2)
+    radius = 0.1 * (g.thigh_m + g.shank_m) / 2
+    sole_centre_x = g.foot_m / 2 - g.heel_back_m
+    sole_centre_z = -g.ankle_height_m + SOLE_THICKNESS_M / 2
+    sole_half = (g.foot_m / 2, max(g.hip_width_m / 4, 0.01), SOLE_THICKNESS_M / 2)
 
     colour = LEG_RGBA[side]
 
@@ -128,15 +126,15 @@ def _leg(side: str, y_m: float, g: LegGeometry, config: RobotConfig, drives: dic
     return f"""
     <body name="thigh_{side}" pos="0 {_f(y_m)} 0">
       {joint("hip")}
-      <geom name="thigh_{side}" type="capsule" fromto="0 0 0 0 0 {_f(-g.thigh)}" size="{_f(radius)}" mass="{_f(mass.thigh_kg)}" rgba="{colour}"/>
-      <body name="shank_{side}" pos="0 0 {_f(-g.thigh)}">
+      <geom name="thigh_{side}" type="capsule" fromto="0 0 0 0 0 {_f(-g.thigh_m)}" size="{_f(radius)}" mass="{_f(mass.thigh_kg)}" rgba="{colour}"/>
+      <body name="shank_{side}" pos="0 0 {_f(-g.thigh_m)}">
         {joint("knee")}
-        <geom name="shank_{side}" type="capsule" fromto="0 0 0 0 0 {_f(-g.shank)}" size="{_f(radius)}" mass="{_f(mass.shank_kg)}" rgba="{colour}"/>
-        <body name="foot_{side}" pos="0 0 {_f(-g.shank)}">
+        <geom name="shank_{side}" type="capsule" fromto="0 0 0 0 0 {_f(-g.shank_m)}" size="{_f(radius)}" mass="{_f(mass.shank_kg)}" rgba="{colour}"/>
+        <body name="foot_{side}" pos="0 0 {_f(-g.shank_m)}">
           {joint("ankle")}
           <geom name="sole_{side}" type="box" pos="{_f(sole_centre_x, 0, sole_centre_z)}" size="{_f(*sole_half)}" mass="{_f(mass.foot_kg)}" rgba="0.2 0.2 0.25 1"/>
-          <geom name="bracket_{side}" type="capsule" fromto="0 0 0 0 0 {_f(-g.ankle_height + SOLE_THICKNESS_M)}" size="{_f(radius * 0.8)}" contype="0" conaffinity="0" mass="0" rgba="{colour}"/>
-          <site name="touch_{side}" type="box" pos="{_f(sole_centre_x, 0, -g.ankle_height + SOLE_THICKNESS_M / 4)}" size="{_f(sole_half[0] + 1e-3, sole_half[1] + 1e-3, SOLE_THICKNESS_M)}" rgba="0 0 0 0"/>
+          <geom name="bracket_{side}" type="capsule" fromto="0 0 0 0 0 {_f(-g.ankle_height_m + SOLE_THICKNESS_M)}" size="{_f(radius * 0.8)}" contype="0" conaffinity="0" mass="0" rgba="{colour}"/>
+          <site name="touch_{side}" type="box" pos="{_f(sole_centre_x, 0, -g.ankle_height_m + SOLE_THICKNESS_M / 4)}" size="{_f(sole_half[0] + 1e-3, sole_half[1] + 1e-3, SOLE_THICKNESS_M)}" rgba="0 0 0 0"/>
         </body>
       </body>
     </body>"""
@@ -147,19 +145,20 @@ def build_mjcf(config: RobotConfig, rate_hz: float, free_pitch: bool = False) ->
 
     rate_hz: the frame rate; the timestep divides a frame into whole substeps_per_frame steps.
     free_pitch: let the torso pitch freely on the boom (default: held upright)."""
-    g = leg_geometry(config)
+    g = config.geometry
     drives = {d.name: d for d in joint_drives(config)}
     timestep = 1.0 / (rate_hz * substeps_per_frame(rate_hz))
-    torso_h = TORSO_HEIGHT_LEGS * g.leg_length
-    radius = 0.1 * g.leg_length / 2
-    torso_half = (max(g.foot / 3, 0.02), g.hip_width / 2 + radius, torso_h / 2)
+    leg_length = g.thigh_m + g.shank_m
+    torso_h = TORSO_HEIGHT_LEGS * leg_length
+    radius = 0.1 * leg_length / 2
+    torso_half = (max(g.foot_m / 3, 0.02), g.hip_width_m / 2 + radius, torso_h / 2)
     pitch = '<joint name="boom_pitch" type="hinge" axis="0 1 0"/>' if free_pitch else ""
     actuators = "\n    ".join(
         f'<position name="{d.name}" joint="{d.name}" kp="{_f(d.kp_nm_per_rad)}" '
         f'forcerange="{_f(-d.stall_torque_nm, d.stall_torque_nm)}" ctrlrange="{_f(math.radians(d.min_deg), math.radians(d.max_deg))}"/>'
         for d in drives.values())
     sensors = "\n    ".join(f'<touch name="touch_{side}" site="touch_{side}"/>' for side in SIDES)
-    legs = "".join(_leg(side, y, g, config, drives) for side, y in zip(SIDES, (g.hip_width / 2, -g.hip_width / 2)))
+    legs = "".join(_leg(side, y, g, config, drives) for side, y in zip(SIDES, (g.hip_width_m / 2, -g.hip_width_m / 2)))
     return f"""<mujoco model="{config.name}">
   <compiler angle="degree" autolimits="true"/>
   <option timestep="{_f(timestep)}" integrator="implicitfast" cone="elliptic" impratio="{_f(IMPRATIO)}"/>
@@ -175,7 +174,7 @@ def build_mjcf(config: RobotConfig, rate_hz: float, free_pitch: bool = False) ->
   <worldbody>
     <light pos="0 -2 3" dir="0 1 -1.5" directional="true"/>
     <geom name="floor" type="plane" size="0 0 0.05" material="grid" contype="1" conaffinity="2"/>
-    <body name="torso" pos="0 0 {_f(g.standing_hip_height)}">
+    <body name="torso" pos="0 0 {_f(leg_length + g.ankle_height_m)}">
       <joint name="boom_x" type="slide" axis="1 0 0"/>
       <joint name="boom_z" type="slide" axis="0 0 1"/>
       {pitch}
