@@ -63,6 +63,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="how long to wait for each status packet (default: the SDK's, about 34 ms at 1 Mbaud)")
     p.add_argument("--trajectory", metavar="FILE", help="walk a trajectory file (.csv/.npz: gaitbot generate, "
                    "eigen synth, record) instead of --steps/--distance; it streams at its own frame rate")
+    p.add_argument("--sim", action="store_true",
+                   help="walk the simulated robot (MuJoCo, the sim extra) and measure whether it really walks")
+    p.add_argument("--free-pitch", action="store_true", help="--sim: let the torso pitch freely (default: held by a boom)")
+    p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (side view)")
+    p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
 
     p = sub.add_parser("check", help="check a trajectory or a recorded run against the robot's limits")
     p.add_argument("file", help="trajectory (.csv, .npz) or bus recording (.jsonl)")
@@ -128,8 +133,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.command in ("plan", "generate", "walk") and len(sources) > 1:
         parser.error(f"{args.command}: give one of --{' / --'.join(sources)}, not several")
     if args.command in ("plan", "generate", "walk") and not sources:
-        if args.command == "walk" and args.dry_run:
-            args.distance = 0.5  # the built-in demo: half a metre on the mock bus
+        if args.command == "walk" and (args.dry_run or args.sim):
+            args.distance = 0.5  # the built-in demo: half a metre on the mock bus or the simulated robot
         else:
             parser.error(f"{args.command}: give --steps or --distance")
     from gaitbot import commands

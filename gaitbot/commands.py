@@ -141,6 +141,9 @@ def _check_rate_override(config, rate) -> None:
 
 
 def cmd_walk(args) -> int:
+    from gaitbot.sim_walk import check_sim_arguments
+
+    check_sim_arguments(args)
     config = load_robot(args.robot)
     _check_rate_override(config, args.rate)
     args.robot = str(config.path)
@@ -150,11 +153,17 @@ def cmd_walk(args) -> int:
         raise UsageError(f"walk refused before anything moved: {report.first_error}")
     frames = angles_to_ticks(config, trajectory.angles_rad)
     period = 1.0 / source.settings.rate_hz
+    sim = None
+    if args.sim:
+        from gaitbot.sim_walk import SimWalk, walk_plan
+
+        sim = SimWalk(config, source.settings.rate_hz, walk_plan(walker, trajectory), args.free_pitch, args.video)
+    hardware = not (args.dry_run or args.sim)
     port = args.port or config.bus.port
-    if not args.dry_run:
+    if hardware:
         _require_port(port)
-    clock = MonotonicClock() if (not args.dry_run or args.realtime) else VirtualClock()
-    if not args.dry_run:
+    clock = MonotonicClock() if (hardware or args.realtime) else VirtualClock()
+    if hardware:
         warning = latency_timer_warning(port)
         if warning:
             print(f"warning: {warning}", file=sys.stderr)
@@ -164,8 +173,11 @@ def cmd_walk(args) -> int:
         recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now)
     if args.reply_timeout_ms is not None and not (math.isfinite(args.reply_timeout_ms) and args.reply_timeout_ms > 0):
         raise UsageError(f"--reply-timeout-ms must be a positive number of milliseconds, got {args.reply_timeout_ms!r}")
-    bus = make_bus(config.bus.backend, config.bus.protocol, port, config.bus.baudrate, config.models_by_id,
-                   dry_run=args.dry_run, recorder=recorder, reply_timeout_ms=args.reply_timeout_ms)
+    if sim is not None:
+        bus = sim.make_bus(clock, recorder)
+    else:
+        bus = make_bus(config.bus.backend, config.bus.protocol, port, config.bus.baudrate, config.models_by_id,
+                       dry_run=args.dry_run, recorder=recorder, reply_timeout_ms=args.reply_timeout_ms)
     bus = LimitGuard(bus, tick_limits(config), {j.id: j.name for j in config.joints})
     velocity, acceleration = joint_limits_ticks(config)
     try:
@@ -180,7 +192,13 @@ def cmd_walk(args) -> int:
         print(f"note: {note}", file=sys.stderr)
     if sys.stderr.isatty():
         sys.stderr.write("\n")
-    if not args.dry_run:
+    if sim is not None and args.json:
+        sim.print_report(True, result.outcome)
+        return result.exit_code
+    if sim is not None:
+        mode = (f"simulated robot (MuJoCo; {config.bus.backend} packets on a simulated bus, simulated clock; "
+                f"torso {'free to pitch' if args.free_pitch else 'on a boom, pitch held'})")
+    elif not args.dry_run:
         mode = f"{config.bus.backend} on {port}"
     elif args.realtime:
         mode = "dry run (mock bus, paced in real time)"
@@ -192,6 +210,8 @@ def cmd_walk(args) -> int:
         print(result.walk_stats.summary())
     if args.record:
         print(f"recording: {args.record}")
+    if sim is not None:
+        sim.print_report(False, result.outcome)
     return result.exit_code
 
 

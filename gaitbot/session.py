@@ -68,7 +68,8 @@ def gait_source(args) -> GaitSource:
                 raise UsageError(f"--{name} must be a positive length in metres, got {value!r}")
         geometry = LegGeometry(thigh=overrides["thigh"] or geometry.thigh, shank=overrides["shank"] or geometry.shank,
                                foot=overrides["foot"] or geometry.foot, hip_width=geometry.hip_width,
-                               ankle_height=0.0 if overrides["foot"] else geometry.ankle_height)
+                               ankle_height=0.0 if overrides["foot"] else geometry.ankle_height,
+                               heel_back=0.0 if overrides["foot"] else geometry.heel_back)
         robot_for_limits = None  # a custom leg is not the robot whose joint limits are configured
     else:
         robot_for_limits = robot

@@ -443,3 +443,46 @@ def test_shipped_configs_fit_the_bus_frame_budget_through_the_hook(tmp_path, nam
         path = tmp_path / "slow.toml"
         path.write_text(slow)
         load_robot_config(path, extra_checks=[bus_can_carry_rate])
+
+
+# --- the simulated robot's tables: [mass], [servo], heel_back_m -----------------------------------
+
+
+def test_mass_and_servo_tables_are_optional_with_a_15_kg_default(tmp_path):
+    text = shipped_text("xl430-biped")
+    a, b = text.index("[mass]"), text.index("[bus]")
+    config = load_text(tmp_path, text[:a] + text[b:])
+    assert config.mass.total_kg == pytest.approx(1.5)
+    assert (config.servo.stall_torque_nm, config.servo.no_load_speed_rpm, config.servo.full_torque_error_deg) == \
+        (None, None, None)
+    assert config.geometry.heel_back_m == 0.0
+
+
+def test_mass_and_servo_values_are_read(tmp_path):
+    text = set_top(shipped_text("xl430-biped"), "torso_kg", "0.55")
+    text += "\n[servo]\nstall_torque_nm = 1.5\nfull_torque_error_deg = 3.0\n"
+    text = re.sub(r"(?m)^(ankle_height_m = .*)$", r"\1\nheel_back_m = 0.03", text, count=1)
+    config = load_text(tmp_path, text)
+    assert config.mass.torso_kg == 0.55 and config.mass.foot_kg == 0.04
+    assert config.servo.stall_torque_nm == 1.5 and config.servo.full_torque_error_deg == 3.0
+    assert config.servo.no_load_speed_rpm is None
+    assert config.geometry.heel_back_m == 0.03
+
+
+@pytest.mark.parametrize("edit, field, words", [
+    (lambda t: set_top(t, "thigh_kg", "0"), "mass.thigh_kg", ("positive",)),
+    (lambda t: set_top(t, "foot_kg", '"light"'), "mass.foot_kg", ("positive number", "string")),
+    (lambda t: t.replace("[mass]\n", "[mass]\ntorso_g = 400\n"), "mass.torso_g", ("unknown key", "torso_kg")),
+    (lambda t: t + "\n[servo]\nstall_torque_nm = -1.0\n", "servo.stall_torque_nm", ("positive",)),
+    (lambda t: t + "\n[servo]\nfull_torque_deg = 3.0\n", "servo.full_torque_deg",
+     ("unknown key", "full_torque_error_deg")),
+    (lambda t: re.sub(r"(?m)^(ankle_height_m = .*)$", r"\1\nheel_back_m = 0.2", t, count=1),
+     "geometry.heel_back_m", ("shorter than foot_m",)),
+])
+def test_bad_mass_servo_or_heel_is_named(tmp_path, edit, field, words):
+    expect_error(tmp_path, edit(shipped_text("xl430-biped")), field, *words)
+
+
+def test_every_servo_model_has_drive_figures():
+    for model in SERVO_MODELS.values():
+        assert model.stall_torque_nm > 0 and model.full_torque_error_deg > 0 and model.no_load_speed_rpm > 0

@@ -4,6 +4,7 @@
     python tools/bench.py gait            # walker: online per frame, offline frames/s, RV solve
     python tools/bench.py stream          # 60 s real-time dry run of the default robot on the mock bus
     python tools/bench.py stream --seconds 10
+    python tools/bench.py sim             # real-time factor of `gaitbot walk --sim` (the sim extra)
 
 Figures are medians/percentiles of repeated measurements with time.perf_counter; nothing here
 is asserted (timed tests are flaky on shared machines).
@@ -120,9 +121,45 @@ def bench_stream(seconds: float) -> None:
     print(f"  {verdict} later than half a period ({half * 1e3:.1f} ms): worst {stats.max_lateness_s * 1e3:.3f} ms late")
 
 
+def bench_sim(distance_m: float = 1.0, repeats: int = 3) -> None:
+    """Real-time factor of `gaitbot walk --sim`: simulated seconds over wall seconds, for the whole
+    command (planning, preflight, model build, the walk through the SDK packet code) and for the
+    physics alone (the standing robot stepped for the same simulated time)."""
+    import contextlib
+    import io
+    import json
+
+    from gaitbot.bus.sim.physics import SimRobot
+    from gaitbot.cli import main as gaitbot_main
+    from gaitbot.robot.config import load_robot_config, resolve_config
+
+    print(f"simulated robot, `gaitbot walk --sim --distance {distance_m:g}` (median of {repeats} runs after a "
+          f"warm-up run, which also builds the gait's step-length table):")
+    for name in ("xl430-biped", "sts3215-biped", "ax12a-biped"):
+        walls, report = [], {}
+        for _ in range(repeats + 1):
+            out = io.StringIO()
+            t0 = time.perf_counter()
+            with contextlib.redirect_stdout(out):
+                gaitbot_main(["walk", "--sim", "--json", "--robot", name, "--distance", str(distance_m)])
+            walls.append(time.perf_counter() - t0)
+            report = json.loads(out.getvalue())
+        walls = walls[1:]
+        simulated = report["simulated_s"]
+        robot = SimRobot(load_robot_config(resolve_config(name)), 60.0)
+        for i in range(6):
+            robot.set_torque(i, True)
+        t0 = time.perf_counter()
+        robot.advance_to(simulated)
+        physics = time.perf_counter() - t0
+        print(f"  {name}: {simulated:.1f} s simulated in {np.median(walls):.2f} s: {simulated / np.median(walls):.0f}x "
+              f"real time (physics alone {simulated / physics:.0f}x; {robot.substeps} steps of "
+              f"{robot.timestep_s * 1e3:.2f} ms per frame)")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("sections", nargs="*", default=["gait", "stream"], help="gait, stream")
+    parser.add_argument("sections", nargs="*", default=["gait", "stream"], help="gait, stream, sim")
     parser.add_argument("--seconds", type=float, default=60.0, help="length of the streaming run")
     args = parser.parse_args()
     print(f"machine: {machine()}")
@@ -131,8 +168,10 @@ def main() -> None:
             bench_gait()
         elif section == "stream":
             bench_stream(args.seconds)
+        elif section == "sim":
+            bench_sim()
         else:
-            parser.error(f"unknown section {section!r} (gait, stream)")
+            parser.error(f"unknown section {section!r} (gait, stream, sim)")
 
 
 if __name__ == "__main__":

@@ -63,14 +63,16 @@ class ConfigError(ValueError):
 
 @dataclass(frozen=True)
 class Geometry:
-    """Leg dimensions in metres: hip-knee, knee-ankle, foot length, distance between the hip
-    joints, and ankle axis above the sole."""
+    """Leg dimensions in metres: hip-knee, knee-ankle, foot length (heel to toe), distance between
+    the hip joints, ankle axis above the sole, and heel behind the ankle axis (0: the heel is the
+    ankle projected on the sole, seed 000's foot)."""
 
     thigh_m: float
     shank_m: float
     foot_m: float
     hip_width_m: float
     ankle_height_m: float = 0.0
+    heel_back_m: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -117,6 +119,35 @@ class JointConfig:
 
 
 @dataclass(frozen=True)
+class MassSettings:
+    """Link masses in kg for the simulated robot (``[mass]``, optional): the torso (with the hip
+    servos, battery and controller) and, per leg, thigh (with the knee servo), shank (with the ankle
+    servo) and foot. The defaults make a 1.5 kg robot: 0.80 + 2 x (0.14 + 0.14 + 0.07)."""
+
+    torso_kg: float = 0.80
+    thigh_kg: float = 0.14
+    shank_kg: float = 0.14
+    foot_kg: float = 0.07
+
+    @property
+    def total_kg(self) -> float:
+        return self.torso_kg + 2.0 * (self.thigh_kg + self.shank_kg + self.foot_kg)
+
+
+@dataclass(frozen=True)
+class ServoSettings:
+    """Overrides of the servo models' drive figures for the simulated robot (``[servo]``, optional).
+
+    None keeps the model's datasheet figure (gaitbot.robot.servo_models): stall torque (N m),
+    no-load speed (rev/min) and the position error at which the position loop gives full torque
+    (degrees; smaller is stiffer, see ServoModel.full_torque_error_deg)."""
+
+    stall_torque_nm: float | None = None
+    no_load_speed_rpm: float | None = None
+    full_torque_error_deg: float | None = None
+
+
+@dataclass(frozen=True)
 class RobotConfig:
     """A whole robot: joints are the walking joints in WALKING_JOINTS order, then the held joints."""
 
@@ -126,6 +157,8 @@ class RobotConfig:
     gait: GaitSettings
     bus: BusSettings
     joints: tuple[JointConfig, ...]
+    mass: MassSettings = MassSettings()
+    servo: ServoSettings = ServoSettings()
 
     @property
     def walking_joints(self) -> tuple[JointConfig, ...]:
@@ -245,9 +278,11 @@ def load_robot_config(path: str | Path, *, extra_checks: Iterable[ConfigCheck] =
     return config
 
 
-_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints")
+_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo")
+_MASS_KEYS = ("torso_kg", "thigh_kg", "shank_kg", "foot_kg")
+_SERVO_KEYS = ("stall_torque_nm", "no_load_speed_rpm", "full_torque_error_deg")
 _ROBOT_KEYS = ("name",)
-_GEOMETRY_KEYS = ("thigh_m", "shank_m", "foot_m", "hip_width_m", "ankle_height_m")
+_GEOMETRY_KEYS = ("thigh_m", "shank_m", "foot_m", "hip_width_m", "ankle_height_m", "heel_back_m")
 _GAIT_KEYS = ("cycle_s", "max_step_m", "clearance_m", "rate_hz")
 _BUS_KEYS = ("backend", "protocol", "port", "baudrate", "torque_off_on_exit")
 _JOINT_KEYS = ("id", "model", "zero_tick", "direction", "min_deg", "max_deg", "max_velocity_dps",
@@ -326,17 +361,38 @@ class _Reader:
         gait = self.gait(self.table(data, "gait", "gait", _GAIT_KEYS))
         bus = self.bus(self.table(data, "bus", "bus", _BUS_KEYS))
         joints = self.joints(data, bus)
-        return RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints)
+        mass = self.mass(self.optional_table(data, "mass", _MASS_KEYS))
+        servo = self.servo(self.optional_table(data, "servo", _SERVO_KEYS))
+        return RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
+                           mass=mass, servo=servo)
+
+    def optional_table(self, data: dict, key: str, allowed: tuple[str, ...]) -> dict:
+        """An optional section: {} when absent, otherwise checked like a required one."""
+        return self.table(data, key, key, allowed) if key in data else {}
+
+    def mass(self, t: dict) -> MassSettings:
+        defaults = MassSettings()
+        return MassSettings(**{k: self.number(t, k, "mass", positive=True, default=getattr(defaults, k))
+                               for k in _MASS_KEYS})
+
+    def servo(self, t: dict) -> ServoSettings:
+        return ServoSettings(**{k: self.number(t, k, "servo", positive=True) if k in t else None
+                                for k in _SERVO_KEYS})
 
     def geometry(self, t: dict) -> Geometry:
         f = "geometry"
-        return Geometry(
+        geometry = Geometry(
             thigh_m=self.number(t, "thigh_m", f, positive=True),
             shank_m=self.number(t, "shank_m", f, positive=True),
             foot_m=self.number(t, "foot_m", f, positive=True),
             hip_width_m=self.number(t, "hip_width_m", f, positive=True),
             ankle_height_m=self.number(t, "ankle_height_m", f, non_negative=True, default=0.0),
+            heel_back_m=self.number(t, "heel_back_m", f, non_negative=True, default=0.0),
         )
+        if geometry.heel_back_m >= geometry.foot_m:
+            raise self.fail("geometry.heel_back_m", f"{geometry.heel_back_m} must be shorter than foot_m "
+                                                    f"{geometry.foot_m} (the heel is behind the ankle, the toe ahead)")
+        return geometry
 
     def gait(self, t: dict) -> GaitSettings:
         f = "gait"

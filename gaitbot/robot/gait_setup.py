@@ -8,10 +8,10 @@ from gaitbot.robot.config import RobotConfig
 
 
 def leg_geometry(config: RobotConfig) -> LegGeometry:
-    """The robot's leg in metres (the heel is the ankle projected on the sole)."""
+    """The robot's leg in metres (the heel heel_back_m behind the ankle, projected on the sole)."""
     g = config.geometry
     return LegGeometry(thigh=g.thigh_m, shank=g.shank_m, foot=g.foot_m, hip_width=g.hip_width_m,
-                       ankle_height=g.ankle_height_m)
+                       ankle_height=g.ankle_height_m, heel_back=g.heel_back_m)
 
 
 def walk_settings(config: RobotConfig, rate_hz: float | None = None) -> WalkSettings:

@@ -39,6 +39,12 @@ class ServoModel:
     len_velocity: int
     no_load_speed_rpm: float
     source: str
+    # Drive figures for the simulated robot (gaitbot.bus.sim), each with its source below:
+    # stall torque in N m at the voltage of no_load_speed_rpm, and the position error at which the
+    # servo's position loop, at its factory gains, asks for full torque (P-only loop: torque grows
+    # linearly with the error up to the stall torque).
+    stall_torque_nm: float
+    full_torque_error_deg: float
 
     @property
     def ticks_per_rad(self) -> float:
@@ -50,6 +56,21 @@ class ServoModel:
     @property
     def no_load_speed_dps(self) -> float:
         return self.no_load_speed_rpm * 6.0
+
+    @property
+    def no_load_speed_rad_s(self) -> float:
+        return self.no_load_speed_rpm * 2.0 * math.pi / 60.0
+
+
+# Dynamixel X series in position mode: a PID on the position error in pulses whose output is PWM,
+# KPP = Position P Gain / 128 (factory 800), PWM Limit 885 = 100 % (e-Manual, XL430-W250 control
+# table, "Position PID Gain" and "PWM Limit"): full PWM at 885 / (800 / 128) = 141.6 pulses =
+# 12.4 deg. (MuJoCo Menagerie's ROBOTIS OP3 model gives its XM430 joints kp 21.1 N m/rad against
+# a 4.1 N m stall torque: full torque at 11.1 deg, the same order.)
+_X_FULL_TORQUE_ERROR_DEG = 885 / (800 / 128) * 360 / 4096
+# AX-12A: factory CW/CCW Compliance Slope 32 (e-Manual, AX-12A control table): the output falls
+# off over the last 32 units (0.29 deg each) before the goal, i.e. full torque beyond 9.4 deg.
+_AX_FULL_TORQUE_ERROR_DEG = 32 * 300 / 1023
 
 
 _X_SERIES = dict(
@@ -75,27 +96,35 @@ SERVO_MODELS: dict[str, ServoModel] = {
         # Torque Enable 64 (1 B), Profile Velocity 112 (4 B), Goal Position 116 (4 B, 0..4095 in
         # position mode), Present Position 132 (4 B, signed); 4096 pulse/rev.
         # No-load speed 57 rev/min at 11.1 V (47 at 9 V, 61 at 12 V).
-        ServoModel(name="XL430-W250", no_load_speed_rpm=57.0,
-                   source="ROBOTIS e-Manual XL430-W250 control table and specifications (57 rpm @ 11.1 V)",
+        # Stall torque 1.4 N m at 11.1 V (1.0 at 9 V, 1.5 at 12 V).
+        ServoModel(name="XL430-W250", no_load_speed_rpm=57.0, stall_torque_nm=1.4,
+                   full_torque_error_deg=_X_FULL_TORQUE_ERROR_DEG,
+                   source="ROBOTIS e-Manual XL430-W250 control table and specifications (57 rpm, 1.4 N m @ 11.1 V)",
                    **_X_SERIES),
         # Verified against emanual.robotis.com/docs/en/dxl/x/xm430-w350/: model number 1020; same
         # X-series addresses (64 / 112 / 116 / 132). No-load speed 46 rev/min at 12.0 V (43 @ 11.1 V).
-        ServoModel(name="XM430-W350", no_load_speed_rpm=46.0,
-                   source="ROBOTIS e-Manual XM430-W350 control table and specifications (46 rpm @ 12 V)",
+        # Stall torque 4.1 N m at 12 V.
+        ServoModel(name="XM430-W350", no_load_speed_rpm=46.0, stall_torque_nm=4.1,
+                   full_torque_error_deg=_X_FULL_TORQUE_ERROR_DEG,
+                   source="ROBOTIS e-Manual XM430-W350 control table and specifications (46 rpm, 4.1 N m @ 12 V)",
                    **_X_SERIES),
         # Verified against emanual.robotis.com/docs/en/dxl/x/xl320/: Protocol 2.0 only, model 350,
         # joint mode 0..1023 over 300 deg; Torque Enable 24 (1 B), Goal Position 30 (2 B),
         # Moving Speed 32 (2 B), Present Position 37 (2 B). No-load speed 114 rev/min at 7.4 V.
+        # Stall torque 0.39 N m at 7.4 V. Its P gain's scale is not documented: the X series figure is assumed.
         ServoModel(name="XL-320", family="dynamixel", protocols=(2.0,), addr_present_position=37,
-                   len_present_position=2, no_load_speed_rpm=114.0,
-                   source="ROBOTIS e-Manual XL-320 control table and specifications (114 rpm @ 7.4 V)",
+                   len_present_position=2, no_load_speed_rpm=114.0, stall_torque_nm=0.39,
+                   full_torque_error_deg=_X_FULL_TORQUE_ERROR_DEG,
+                   source="ROBOTIS e-Manual XL-320 control table and specifications (114 rpm, 0.39 N m @ 7.4 V)",
                    **_AX_TABLE),
         # Verified against emanual.robotis.com/docs/en/dxl/ax/ax-12a/: Protocol 1.0, model 12,
         # 0..1023 over 300 deg (0.29 deg/unit), Torque Enable 24, Goal Position 30 (2 B),
         # Moving Speed 32 (2 B), Present Position 36 (2 B). No-load speed 59 rev/min at 12 V.
+        # Stall torque 1.5 N m at 12 V.
         ServoModel(name="AX-12A", family="dynamixel", protocols=(1.0,), addr_present_position=36,
-                   len_present_position=2, no_load_speed_rpm=59.0,
-                   source="ROBOTIS e-Manual AX-12A control table and specifications (59 rpm @ 12 V)",
+                   len_present_position=2, no_load_speed_rpm=59.0, stall_torque_nm=1.5,
+                   full_torque_error_deg=_AX_FULL_TORQUE_ERROR_DEG,
+                   source="ROBOTIS e-Manual AX-12A control table and specifications (59 rpm, 1.5 N m @ 12 V)",
                    **_AX_TABLE),
         # Verified against the Feetech SMS/STS memory table as transcribed in LeRobot
         # (lerobot/motors/feetech/tables.py, STS_SMS_SERIES_CONTROL_TABLE): model number 777 at
@@ -104,15 +133,21 @@ SERVO_MODELS: dict[str, ServoModel] = {
         # No-load speed varies by variant: 0.222 s/60 deg = 45 rpm is the 12 V (C018) figure, the
         # 7.4 V ST3215 is listed at 0.192 s/60 deg = 52 rpm. 45 rpm is kept: the lower figure is the
         # conservative one for speed-limit checks.
+        # Stall torque: 19.5 kg cm = 1.9 N m for the 7.4 V ST3215 (30 kg cm at 12 V); the lower figure is
+        # kept, like the speed. Feetech does not document the scale of its P coefficient (factory 32):
+        # the X series figure is assumed.
         ServoModel(name="STS3215", resolution_ticks=4096, range_deg=360.0, min_tick=0, max_tick=4095,
                    centre_tick=2048, wraps=True, byte_order="little", no_load_speed_rpm=45.0,
+                   stall_torque_nm=1.9, full_torque_error_deg=_X_FULL_TORQUE_ERROR_DEG,
                    source="Feetech SMS/STS memory table (via LeRobot tables.py); STS3215 datasheet 45 rpm",
                    **_FEETECH_TABLE),
         # Verified against the Feetech SCSCL memory table (LeRobot SCS_SERIES_CONTROL_TABLE): model 1284,
         # same addresses 40 / 42 / 46 / 56; SCS stores words high byte first (SCS_END 1).
         # SC09/SCS0009 product page: 300 deg over 0..1023 (0.293 deg/step), 0.1 s/60 deg = 100 rpm at 6 V.
+        # Stall torque 2.3 kg cm = 0.23 N m at 6 V (SC09 product page); P coefficient scale assumed as above.
         ServoModel(name="SCS0009", resolution_ticks=1024, range_deg=300.0, min_tick=0, max_tick=1023,
                    centre_tick=512, wraps=False, byte_order="big", no_load_speed_rpm=100.0,
+                   stall_torque_nm=0.23, full_torque_error_deg=_X_FULL_TORQUE_ERROR_DEG,
                    source="Feetech SCSCL memory table (via LeRobot tables.py); SC09 spec 100 rpm @ 6 V",
                    **_FEETECH_TABLE),
     )

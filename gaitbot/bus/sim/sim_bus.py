@@ -1,0 +1,98 @@
+"""The simulation bus: the real Dynamixel/Feetech backend and SDK packet code on a port whose servos
+are the simulated robot's joints.
+
+SimPort is the mock port (gaitbot.bus.mock: parses every instruction packet and answers as the
+servos would) with physics behind the control tables instead of ideal servos:
+
+* before each packet is handled, the physics advances to the clock's present time, so a goal
+  takes effect at the moment the streamer sends it and holds until the next one;
+* a goal-position write becomes the joint's actuator target (ticks -> angle by the robot's
+  calibration, the inverse of what the streamer did);
+* a torque-enable write switches the joint's servo on or off;
+* a present-position read answers the simulated joint angle (angle -> ticks by the calibration).
+
+Joints the model does not have (held joints such as the ax12a-biped's hip roll) stay ideal mock
+servos. Everything else (pings, checksums, status packets, the recorder) is the mock's, so a
+``--sim --record`` recording holds exactly the packets a real run would send.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gaitbot.bus.base import Bus
+from gaitbot.bus.factory import BACKENDS
+from gaitbot.bus.mock import MockPort
+from gaitbot.bus.recording import BusRecorder
+from gaitbot.bus.sim.physics import SimRobot
+from gaitbot.clock import Clock
+from gaitbot.robot.calibration import angle_rad_to_ticks, ticks_to_angle_rad
+from gaitbot.robot.config import RobotConfig
+
+
+class SimPort(MockPort):
+    """A MockPort whose walking servos are ``robot``'s joints, on ``clock``'s time."""
+
+    def __init__(self, config: RobotConfig, robot: SimRobot, clock: Clock, port_name: str = "sim") -> None:
+        super().__init__(config.bus.backend, config.bus.protocol, config.models_by_id, port_name=port_name)
+        self.robot = robot
+        self.clock = clock
+        walking = config.walking_joints
+        self.joint_of = {j.id: i for i, j in enumerate(walking)}
+        self._ids = [j.id for j in walking]
+        self._calibration = {j.id: (j.zero_tick, j.direction, j.model.ticks_per_rad) for j in walking}
+        self._zero, self._direction, self._per_rad = (np.array(v, dtype=float) for v in zip(
+            *(self._calibration[i] for i in self._ids)))
+        self._tick_range = (np.array([j.model.min_tick for j in walking]), np.array([j.model.max_tick for j in walking]))
+
+    def writePort(self, packet) -> int:  # noqa: N802 (SDK name)
+        self.robot.advance_to(self.clock.now())
+        return super().writePort(packet)
+
+    def _read(self, frame) -> None:
+        self._refresh_present()
+        super()._read(frame)
+
+    def _sync_read(self, frame) -> None:
+        self._refresh_present()
+        super()._sync_read(frame)
+
+    def _refresh_present(self) -> None:
+        """Write the simulated joint angles, as ticks, into the present-position registers."""
+        ticks = np.clip(angle_rad_to_ticks(self.robot.joint_angles_rad(), self._zero, self._direction, self._per_rad),
+                        *self._tick_range)
+        for servo_id, tick in zip(self._ids, ticks.tolist()):
+            model = self.models[servo_id]
+            start = model.addr_present_position
+            self.tables[servo_id][start:start + model.len_present_position] = \
+                tick.to_bytes(model.len_present_position, model.byte_order)
+
+    def _store(self, servo_id: int, address: int, data: bytes) -> None:
+        joint = self.joint_of.get(servo_id)
+        if joint is None:
+            super()._store(servo_id, address, data)  # a held joint: an ideal servo
+            return
+        table, model = self.tables[servo_id], self.models[servo_id]
+        table[address:address + len(data)] = data
+        if _overlaps(address, len(data), model.addr_goal_position, model.len_goal_position):
+            start = model.addr_goal_position
+            ticks = int.from_bytes(table[start:start + model.len_goal_position], model.byte_order)
+            self.robot.set_goal(joint, float(ticks_to_angle_rad(ticks, *self._calibration[servo_id])))
+        if _overlaps(address, len(data), model.addr_torque_enable, 1):
+            self.robot.set_torque(joint, bool(table[model.addr_torque_enable]))
+
+
+def _overlaps(start: int, length: int, field_start: int, field_length: int) -> bool:
+    return start < field_start + field_length and field_start < start + length
+
+
+def make_sim_bus(config: RobotConfig, robot: SimRobot, clock: Clock, recorder: BusRecorder | None = None) -> Bus:
+    """The robot's own bus class (Dynamixel or Feetech, with its SDK) on a SimPort.
+
+    Like a dry run, but the servos are ``robot``'s joints; the bus is not opened here."""
+    cls = BACKENDS[config.bus.backend]
+    handler = SimPort(config, robot, clock)
+    if recorder is not None:
+        handler = recorder.wrap(handler, backend=config.bus.backend, protocol=config.bus.protocol,
+                                baudrate=config.bus.baudrate, models=config.models_by_id)
+    return cls("sim", config.bus.baudrate, config.bus.protocol, config.models_by_id, port_handler=handler)

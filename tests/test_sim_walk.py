@@ -1,0 +1,164 @@
+"""gaitbot walk --sim end to end: does the planned walk really walk on the simulated robot?
+
+The plan's distance and swing windows come from `gaitbot plan --json` (the gait's own account of
+itself); the measurements come from the simulation. The judged figures (README, "The simulated
+robot") are the 0.5 m walks below.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+from gaitbot.bus.sim import SimUnavailable, import_mujoco  # noqa: E402  (picks the offscreen GL first)
+
+try:
+    import_mujoco()
+except SimUnavailable:
+    pytest.skip("the sim extra (MuJoCo) is not installed", allow_module_level=True)
+
+from gaitbot.cli import main  # noqa: E402
+
+CONFIG_DIR = Path(__file__).resolve().parents[1] / "config"
+ROBOTS = ("xl430-biped", "sts3215-biped", "ax12a-biped")
+KEYS = ("distance_planned_m", "distance_travelled_m", "fell", "fell_at_s", "max_slip_m", "scuff_fraction",
+        "max_torque_fraction", "max_tracking_error_deg")
+
+
+def sim_json(capsys, *args: str) -> dict:
+    capsys.readouterr()
+    assert main(["walk", "--sim", "--json", *args]) == 0
+    return json.loads(capsys.readouterr().out)  # the whole of stdout is one JSON object
+
+
+def planned_distance(capsys, *args: str) -> float:
+    capsys.readouterr()
+    assert main(["plan", "--json", *args]) == 0
+    plan = json.loads(capsys.readouterr().out)
+    return plan["total_distance_m"]
+
+
+def fixed_robot(name: str, tmp_path: Path) -> Path:
+    """The shipped robot with the two changes the README names: servo position loops 6 times stiffer
+    than factory (full torque at 2 deg) and the ankle a third of the foot ahead of the heel."""
+    text = (CONFIG_DIR / f"{name}.toml").read_text()
+    foot = float(re.search(r"^foot_m = ([0-9.]+)", text, re.M).group(1))
+    text = re.sub(r"^(ankle_height_m = .*)$", rf"\1\nheel_back_m = {foot / 3:.4f}", text, count=1, flags=re.M)
+    path = tmp_path / f"{name}-fixed.toml"
+    path.write_text(text + "\n[servo]\nfull_torque_error_deg = 2.0\n")
+    return path
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_flat_walk_of_a_shipped_robot_stays_up_on_clean_swings(name, capsys):
+    r = sim_json(capsys, "--robot", name, "--distance", "0.5")
+    assert set(KEYS) <= set(r)
+    assert r["distance_planned_m"] == pytest.approx(planned_distance(capsys, "--robot", name, "--distance", "0.5"))
+    assert r["fell"] is False and r["fell_at_s"] is None
+    assert r["scuff_fraction"] < 0.05
+    assert 0.0 < r["max_torque_fraction"] <= 1.0
+
+
+# Measured (README, "The simulated robot"): 0.311 / 0.282 / 0.277 m of 0.5 m (62 / 56 / 55%). Two causes,
+# shown by the test after this one: (1) the gait stands on the toe of its stance foot through single
+# support, and the shipped feet have the ankle at the heel, so the whole weight acts a foot length ahead
+# of the ankle; (2) at factory gains the servos need 9 to 12 deg of error for full torque, so the stance
+# leg sags and every swing foot lands short.
+@pytest.mark.xfail(strict=True, reason="shipped robots travel 55-62% of the plan at factory servo gains "
+                                       "(toe stance with the ankle at the heel; soft position loops)")
+@pytest.mark.parametrize("name", ROBOTS)
+def test_flat_walk_of_a_shipped_robot_travels_within_10_percent_of_the_plan(name, capsys):
+    r = sim_json(capsys, "--robot", name, "--distance", "0.5")
+    assert r["distance_travelled_m"] == pytest.approx(r["distance_planned_m"], rel=0.10)
+    assert r["max_slip_m"] < 0.002
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_with_stiff_servos_and_the_ankle_over_the_foot_the_walk_travels_within_10_percent(name, capsys, tmp_path):
+    robot = str(fixed_robot(name, tmp_path))
+    r = sim_json(capsys, "--robot", robot, "--distance", "0.5")
+    assert r["distance_planned_m"] == pytest.approx(planned_distance(capsys, "--robot", robot, "--distance", "0.5"))
+    assert r["distance_travelled_m"] == pytest.approx(r["distance_planned_m"], rel=0.10)
+    assert r["fell"] is False
+    assert r["scuff_fraction"] < 0.05
+    assert r["max_slip_m"] < 0.002
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_a_toe_dragging_walk_is_caught_by_the_scuff_fraction(name, capsys):
+    """With the swing clearance turned off the swing sole only just clears the floor in the plan; on
+    the robot it drags through a large share of every swing, and the robot hardly gets anywhere."""
+    dragging = sim_json(capsys, "--robot", name, "--distance", "0.4", "--clearance", "0")
+    clean = sim_json(capsys, "--robot", name, "--distance", "0.4")
+    assert dragging["scuff_fraction"] > 0.15
+    assert clean["scuff_fraction"] < 0.05
+    assert dragging["distance_travelled_m"] < 0.5 * clean["distance_travelled_m"]
+
+
+def test_free_pitch_is_reported_as_a_fall_with_its_time(capsys):
+    r = sim_json(capsys, "--free-pitch", "--distance", "0.3")
+    assert r["free_pitch"] is True
+    assert r["fell"] is True
+    assert 0.0 < r["fell_at_s"] < r["simulated_s"]
+    assert r["fall_reason"]
+
+
+def test_a_simulated_walk_is_deterministic(capsys):
+    first = sim_json(capsys, "--robot", "ax12a-biped", "--steps", "0.04,0.04")
+    second = sim_json(capsys, "--robot", "ax12a-biped", "--steps", "0.04,0.04")
+    assert first == second
+
+
+def test_summary_names_the_measurements(capsys):
+    assert main(["walk", "--sim", "--steps", "0.03"]) == 0
+    out = capsys.readouterr().out
+    assert "simulated robot" in out and "travelled" in out and "scuff" in out and "slip" in out
+
+
+@pytest.mark.parametrize("suffix", (".gif", ".mp4"))
+def test_video_of_the_walk_is_written(suffix, tmp_path, capsys):
+    path = tmp_path / f"walk{suffix}"
+    assert main(["walk", "--sim", "--steps", "0.03", "--video", str(path)]) == 0
+    assert f"video: {path}" in capsys.readouterr().out
+    data = path.read_bytes()
+    if suffix == ".gif":
+        from PIL import Image
+
+        assert data[:6] in (b"GIF87a", b"GIF89a")
+        with Image.open(path) as gif:
+            assert gif.n_frames >= 20 * 3  # 20 frames per second of a walk over 3 s long
+            assert gif.size == (480, 320)
+            first = gif.convert("RGB")
+            gif.seek(gif.n_frames // 2)
+            assert first.tobytes() != gif.convert("RGB").tobytes()  # the picture moves
+    else:
+        assert data[4:8] == b"ftyp"  # an MP4 (ISO base media) file
+        assert len(data) > 10_000
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--sim", "--dry-run"], "--dry-run: give --sim or --dry-run, not both"),
+    (["--sim", "--port", "/dev/ttyUSB0"], "--port: a simulated walk has no serial port"),
+    (["--sim", "--realtime"], "--realtime: a simulated walk runs on the simulated clock"),
+    (["--dry-run", "--video", "walk.gif"], "--video: only with --sim"),
+    (["--dry-run", "--free-pitch"], "--free-pitch: only with --sim"),
+    (["--dry-run", "--json"], "--json: only with --sim"),
+    (["--sim", "--video", "walk.avi"], "--video walk.avi: the file must end in .gif or .mp4"),
+    (["--sim", "--terrain", str(CONFIG_DIR / "terrain" / "kerb.toml")], "--terrain: the simulated floor is flat"),
+    (["--sim", "--thigh", "0.2"], "--thigh: the simulated robot is built from the robot config"),
+])
+def test_what_a_simulated_walk_cannot_do_is_one_line_and_exit_2(args, message, capsys):
+    assert main(["walk", *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and "\n" not in err
+
+
+def test_missing_mujoco_is_one_line_naming_the_sim_extra(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "mujoco", None)  # makes `import mujoco` fail as if not installed
+    assert main(["walk", "--sim"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "pip install 'gaitbot[sim]'" in err and "\n" not in err
