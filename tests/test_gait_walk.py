@@ -3,8 +3,8 @@
 The forward kinematics below is written here from gait-model.md section 1, independently of
 gaitbot.gait.geometry: thigh direction h from the downward vertical, shank h - k, sole pitch
 (h - k) + a from the horizontal (toe up positive); the sole lies ``ankle_height`` below the ankle,
-perpendicular to the sole; the heel is the ankle projected on the sole (heel_back = 0) and the toe
-is ``foot`` ahead of the heel along the sole. Both hips sit at the root point (sagittal plane).
+perpendicular to the sole; the heel is ``heel_back`` behind the ankle's projection on the sole
+(0 for seed 000's leg) and the toe is ``foot`` ahead of the heel along the sole. Both hips sit at the root point (sagittal plane).
 
 The plan (step start/end times, the swinging leg, toe-off share) is read from ``plan_walk`` only to
 know *when* each invariant applies; every position is recomputed here from angles and root.
@@ -34,15 +34,17 @@ LEGS = ("left", "right")
 # --------------------------------------------------------------------------------------------
 # independent forward kinematics
 # --------------------------------------------------------------------------------------------
-def fk_leg(q: np.ndarray, thigh: float, shank: float, foot: float, ankle_height: float) -> dict:
+def fk_leg(q: np.ndarray, thigh: float, shank: float, foot: float, ankle_height: float,
+           heel_back: float = 0.0) -> dict:
     """Knee, ankle, heel and toe relative to the hip for leg angles q (n, 3) = hip, knee, ankle flexion."""
     h, k, a = q[:, 0], q[:, 1], q[:, 2]
     knee = np.column_stack([thigh * np.sin(h), -thigh * np.cos(h)])
     ankle = knee + np.column_stack([shank * np.sin(h - k), -shank * np.cos(h - k)])
     p = (h - k) + a
     # unit vector along the sole (cos p, sin p); "down, perpendicular to the sole" is (sin p, -cos p)
-    heel = ankle + ankle_height * np.column_stack([np.sin(p), -np.cos(p)])
-    toe = heel + foot * np.column_stack([np.cos(p), np.sin(p)])
+    along_sole = np.column_stack([np.cos(p), np.sin(p)])
+    heel = ankle + ankle_height * np.column_stack([np.sin(p), -np.cos(p)]) - heel_back * along_sole
+    toe = heel + foot * along_sole
     return {"knee": knee, "ankle": ankle, "heel": heel, "toe": toe, "pitch": p}
 
 
@@ -97,7 +99,7 @@ def make_walk(geometry: LegGeometry, steps, settings: WalkSettings | None = None
     g = geometry
     pts = {}
     for j, leg in enumerate(LEGS):
-        rel = fk_leg(traj.angles_rad[:, 3 * j:3 * j + 3], g.thigh, g.shank, g.foot, g.ankle_height)
+        rel = fk_leg(traj.angles_rad[:, 3 * j:3 * j + 3], g.thigh, g.shank, g.foot, g.ankle_height, g.heel_back)
         pts[leg] = {k: (v + traj.root_m if k != "pitch" else v) for k, v in rel.items()}
     rate = 1.0 / (traj.t_s[1] - traj.t_s[0])
     return Walk(g, settings, list(steps), walker, traj, pts, rate)
@@ -557,7 +559,7 @@ def _corrupt(name: str, root_fn=None, angles_fn=None) -> str:
     g = w.geometry
     pts = {}
     for j, leg in enumerate(LEGS):
-        rel = fk_leg(angles[:, 3 * j:3 * j + 3], g.thigh, g.shank, g.foot, g.ankle_height)
+        rel = fk_leg(angles[:, 3 * j:3 * j + 3], g.thigh, g.shank, g.foot, g.ankle_height, g.heel_back)
         pts[leg] = {k: (v + root if k != "pitch" else v) for k, v in rel.items()}
     key = f"corrupt-{len(_CACHE)}"
     _CACHE[key] = Walk(g, w.settings, w.steps, w.walker, traj, pts, w.rate)
