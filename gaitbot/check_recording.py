@@ -29,6 +29,9 @@ Choices:
   one instant). A corrupted goal write is ignored by the servos, so it is left out of the motion
   (but still counts as a frame for timing: the byte went out on time). A joint missing from a frame
   keeps its previous goal, which is what the servo does.
+* Settings: WRITE packets to other registers than goal and torque (the servos' gain registers a
+  session writes before torque on, gaitbot/recorded_settings.py) are accepted like any well-formed
+  packet to a configured id, and listed in the report ("settings written").
 * Packets: a malformed packet, tx or rx, is an error (exit 1) naming line, time and bytes -- it is a
   fault of the run, not an unreadable file. A status packet reporting a servo error is a warning.
   An unparseable JSON line, a line without t/dir/hex, a missing header and a truncated last line
@@ -48,6 +51,7 @@ import numpy as np
 from gaitbot.bus import wire
 from gaitbot.bus.log_decoder import LOG_FORMAT, LOG_VERSION, RecordedPacket, RecordingError, parse_packet
 from gaitbot.check import CheckReport, check_trajectory
+from gaitbot.recorded_settings import SettingWrite, describe_settings, setting_write
 from gaitbot.robot.calibration import ticks_to_angles
 from gaitbot.robot.config import RobotConfig
 from gaitbot.robot.servo_models import servo_model
@@ -131,6 +135,8 @@ class RecordingReport:
     joints: CheckReport
     sample_lines: tuple[int, ...]  # line of each motion sample, in order (for naming lines)
     sample_t_s: tuple[float, ...]
+    settings: tuple[SettingWrite, ...] = ()  # gain (and other setting) writes, in file order
+    settings_text: tuple[str, ...] = ()  # the same, one line per register and value, for people
 
     @property
     def errors(self) -> tuple[BusIssue, ...]:
@@ -181,6 +187,7 @@ class RecordingReport:
             "first_error": self.first_error,
             "frame_timing": asdict(self.timing),
             "bus_issues": [{**asdict(i), "message_line": i.describe()} for i in self.issues],
+            "settings": [asdict(w) for w in self.settings],
             "joint_check": joint_violations,
         }
 
@@ -193,6 +200,7 @@ class RecordingReport:
                  f"{_count(self.issues, 'packet')} malformed, {_count(self.issues, 'ids')} id problems, "
                  f"{_count(self.issues, 'timing')} timing problems",
                  self.timing.describe(),
+                 *(f"settings written: {line}" for line in self.settings_text),
                  "",
                  "joint limits, goal ticks decoded to angles at the recorded send times:",
                  self.joints.format_text(max_per_kind)]
@@ -421,6 +429,8 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
 
     timing_t, timing_line = [], []  # every goal write, valid or not
     frames_t, frames_line, frames_rows = [], [], []
+    models = {j.id: j.model for j in config.joints}
+    settings: list[SettingWrite] = []
     for p in packets:
         if p.parsed is None or p.problem:
             issues.append(BusIssue("packet", "error", p.line_no, p.t_s,
@@ -436,6 +446,9 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
             continue
         is_goal = pk.instruction == wire.INST_SYNC_WRITE and (pk.address, pk.data_length) == (goal_addr, goal_len)
         issues += _unknown_id_issues(p, pk, known, is_goal)
+        setting = setting_write(p.line_no, p.t_s, pk, models[pk.packet_id]) if pk.packet_id in models else None
+        if setting is not None:
+            settings.append(setting)
         if is_goal:
             row, frame_issues = _goal_row(p, pk, goal_len, config, column, names, signed)
             issues += frame_issues
@@ -462,7 +475,8 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
                            n_tx=sum(1 for p in packets if p.direction == "tx"),
                            n_rx=sum(1 for p in packets if p.direction == "rx"), n_goal_frames=len(frames_t),
                            timing=timing, issues=tuple(issues), joints=joints,
-                           sample_lines=tuple(int(x) for x in lines), sample_t_s=tuple(float(x) for x in t_s))
+                           sample_lines=tuple(int(x) for x in lines), sample_t_s=tuple(float(x) for x in t_s),
+                           settings=tuple(settings), settings_text=tuple(describe_settings(tuple(settings), models)))
 
 
 def _id_label(servo_id: int, names: dict[int, str]) -> str:

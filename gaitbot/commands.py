@@ -14,8 +14,8 @@ from gaitbot.bus.recording import BusRecorder
 from gaitbot.clock import MonotonicClock, VirtualClock
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.calibration import angles_to_ticks, standing_ticks, tick_limits
-from gaitbot.session import (UsageError, gait_source, joint_limits_ticks, load_robot, plan_summary, preflight,
-                             trajectory_for_robot)
+from gaitbot.session import (UsageError, gain_notes, gain_writes, gait_source, joint_limits_ticks, load_robot,
+                             plan_summary, preflight, trajectory_for_robot)
 from gaitbot.stream import latency_timer_warning, walk_session
 
 
@@ -180,11 +180,14 @@ def cmd_walk(args) -> int:
                        dry_run=args.dry_run, recorder=recorder, reply_timeout_ms=args.reply_timeout_ms)
     bus = LimitGuard(bus, tick_limits(config), {j.id: j.name for j in config.joints})
     velocity, acceleration = joint_limits_ticks(config)
+    for note in gain_notes(config):
+        print(f"note: {note}", file=sys.stderr)
     try:
         result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
                               max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
                               torque_off_on_exit=config.bus.torque_off_on_exit,
-                              on_frame=_status_line(len(frames), walker.heel_strikes, source.settings.rate_hz))
+                              on_frame=_status_line(len(frames), walker.heel_strikes, source.settings.rate_hz),
+                              setup_writes=gain_writes(config))
     finally:
         if recorder is not None:
             recorder.close()

@@ -23,8 +23,9 @@ moves the legs):
 
 Torque stays off at every exit (the person holding the legs keeps them). With ``hold_at_end``,
 after a completed, stopped or terminated recording the pose is held instead: present positions
-are read once more, written as goals (through the caller's LimitGuard, which refuses a pose
-outside the joint limits) and torque goes on, in that order, as a walk starts. If any of that
+are read once more, the session's settings are written (``setup_writes``: the servos' gains, as a
+walk writes them), the pose is written as goals (through the caller's LimitGuard, which refuses a
+pose outside the joint limits) and torque goes on, in that order, as a walk starts. If any of that
 fails, torque goes off again on every servo and a note says why. After a bus error nothing more
 is tried beyond the torque-off that is already in place. ``sink.close()`` and ``bus.close()``
 run in a ``finally``, so every sample read is in the file whatever happens.
@@ -39,9 +40,10 @@ from typing import Protocol
 
 import numpy as np
 
-from gaitbot.bus.base import Bus, BusError
+from gaitbot.bus.base import Bus, BusError, RegisterWrite
 from gaitbot.clock import Clock, MonotonicClock
-from gaitbot.stream import EXIT_CODES, LATE_THRESHOLD_S, Terminated, paced_deadlines, prepare, sigterm_raises_terminated
+from gaitbot.stream import (EXIT_CODES, LATE_THRESHOLD_S, Terminated, paced_deadlines, prepare,
+                            sigterm_raises_terminated, write_settings)
 
 #: Exit status of each outcome: a stopped recording (Ctrl-C) is a normal end.
 RECORD_EXIT_CODES = {"declined": 0, "completed": 0, "stopped": 0, "terminated": EXIT_CODES["terminated"],
@@ -113,7 +115,8 @@ class RecordResult:
 
 def record_session(bus: Bus, ids: Sequence[int], period_s: float, sink: SampleSink, *,
                    confirm: Callable[[int], bool], n_samples: int | None = None, clock: Clock | None = None,
-                   hold_at_end: bool = False, handle_sigterm: bool = True) -> RecordResult:
+                   hold_at_end: bool = False, handle_sigterm: bool = True,
+                   setup_writes: Sequence[RegisterWrite] = ()) -> RecordResult:
     """Record until ``n_samples`` are read, Ctrl-C, SIGTERM or a bus error (see the module docstring).
 
     ``confirm(n)`` asks the person whether ``n`` servos may go limp. ``bus`` should be wrapped in a
@@ -149,7 +152,7 @@ def record_session(bus: Bus, ids: Sequence[int], period_s: float, sink: SampleSi
             except OSError as exc:  # the sink's file; the bus's own OS errors arrive as PortError
                 outcome, error = "file_error", exc
             if hold_at_end and outcome in ("completed", "stopped", "terminated") and state["torque"] == "off":
-                state["torque"] = _hold_present_pose(bus, ids, notes)
+                state["torque"] = _hold_present_pose(bus, ids, notes, setup_writes)
             elif state["torque"] == "off":
                 notes.append("torque stays off")
         finally:
@@ -183,10 +186,11 @@ def _read_loop(bus: Bus, ids: list[int], period_s: float, sink: SampleSink, cloc
             sink.sync()
 
 
-def _hold_present_pose(bus: Bus, ids: list[int], notes: list[str]) -> str:
-    """Present pose as goal, then torque on (the order a walk starts in); on any failure torque off again."""
+def _hold_present_pose(bus: Bus, ids: list[int], notes: list[str], setup_writes: Sequence[RegisterWrite]) -> str:
+    """Settings, present pose as goal, then torque on (the order a walk starts in); on any failure torque off again."""
     try:
         present = bus.read_present_ticks(ids)
+        write_settings(bus, setup_writes)
         bus.write_goal_ticks({i: int(present[i]) for i in ids})
         bus.set_torque(ids, True)
         notes.append("torque on, holding the pose read last")

@@ -31,7 +31,7 @@ from gaitbot.record import record_session
 from gaitbot.robot.calibration import ticks_to_angles, tick_limits
 from gaitbot.robot.config import RobotConfig
 from gaitbot.robot.gait_setup import leg_geometry
-from gaitbot.session import UsageError, load_robot
+from gaitbot.session import UsageError, gain_notes, gain_writes, load_robot
 
 QUESTION = "Turn torque off on {n} servos? The legs will go limp. [y/N] "
 
@@ -170,8 +170,11 @@ def run_record(args) -> int:
     clock = VirtualClock() if args.dry_run else MonotonicClock()
     if n_samples is None:
         print(f"recording at {rate_hz:g} Hz until Ctrl-C", file=sys.stderr)
+    if args.hold:
+        for note in gain_notes(config):
+            print(f"note: {note}", file=sys.stderr)
     result = record_session(bus, config.ids, 1.0 / rate_hz, sink, confirm=confirm, n_samples=n_samples, clock=clock,
-                            hold_at_end=args.hold)
+                            hold_at_end=args.hold, setup_writes=gain_writes(config))
     if sink.status is not None and sink.writer is not None:
         sys.stderr.write("\n")
     for note in getattr(bus, "open_notes", []):

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gaitbot.bus.base import RegisterWrite
 from gaitbot.bus.budget import check_rate
 from gaitbot.check import CheckReport, check_trajectory, trajectory_angles_deg
 from gaitbot.gait.geometry import LegGeometry
@@ -21,6 +22,7 @@ from gaitbot.gait.trajectory import Trajectory
 from gaitbot.gait.walker import OnlineWalker, WalkSettings, make_context, plan_walk, trajectory_of
 from gaitbot.robot.config import ConfigError, RobotConfig, default_config_path, load_robot_config, resolve_config
 from gaitbot.robot.gait_setup import leg_geometry, walk_settings
+from gaitbot.robot.servo_gains import gain_plan
 
 
 class UsageError(ValueError):
@@ -45,6 +47,19 @@ def load_robot(robot: str | None) -> RobotConfig:
         raise
     except (OSError, ValueError, KeyError) as exc:
         raise UsageError(f"--robot {robot}: {exc}") from None
+
+
+def gain_writes(config: RobotConfig) -> tuple[RegisterWrite, ...]:
+    """What a session writes before torque on to give every servo ``[servo] full_torque_error_deg``
+    (nothing without it), one register write per servo model and register (checked at load)."""
+    return tuple(RegisterWrite(ids, w.address, w.length, w.value, w.name)
+                 for setting, ids in gain_plan(config) for w in setting.writes)
+
+
+def gain_notes(config: RobotConfig) -> list[str]:
+    """One line per servo model for people: which gain is written and the stiffness it gives."""
+    return [f"servo stiffness: {setting.describe()}, written to ids {', '.join(map(str, sorted(ids)))} before "
+            f"torque on (in RAM: lasts until power-off)" for setting, ids in gain_plan(config)]
 
 
 @dataclass(frozen=True)

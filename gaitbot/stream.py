@@ -34,13 +34,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from gaitbot.bus.base import Bus, BusError, PortError, ServoTimeout
+from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite, ServoTimeout
 from gaitbot.clock import Clock, MonotonicClock, VirtualClock
 from gaitbot.ramp import brake_ticks, ramp_ticks, stop_ticks
 
 __all__ = [
     "Clock", "MonotonicClock", "VirtualClock", "ramp_ticks", "brake_ticks", "stop_ticks",
-    "StreamStats", "Streamer", "MissingServosError", "Terminated", "prepare", "paced_deadlines",
+    "StreamStats", "Streamer", "MissingServosError", "Terminated", "prepare", "write_settings", "paced_deadlines",
     "sigterm_raises_terminated",
     "SessionResult", "walk_session", "latency_timer_warning",
     "LATE_THRESHOLD_S", "EXIT_CODES",
@@ -303,6 +303,13 @@ def prepare(bus: Bus, ids: Sequence[int]) -> np.ndarray:
     return np.array([int(present[i]) for i in ids], dtype=np.int64)
 
 
+def write_settings(bus: Bus, writes: Iterable[RegisterWrite]) -> None:
+    """Write the session's settings (the servos' gain registers), in order, each servo confirming its
+    own; called before torque goes on, so a servo never moves with the stiffness it had before."""
+    for write in writes:
+        bus.write_register(write.ids, write.address, write.length, write.value)
+
+
 # --------------------------------------------------------------------------- the session
 
 class Terminated(BaseException):
@@ -353,10 +360,12 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
                  period_s: float = 1 / 60, clock: Clock | None = None,
                  torque_off_on_exit: bool = False,
                  on_frame: Callable[[int, StreamStats], None] | None = None,
-                 handle_sigterm: bool = True, monitor_servos: bool = True) -> SessionResult:
+                 handle_sigterm: bool = True, monitor_servos: bool = True,
+                 setup_writes: Sequence[RegisterWrite] = ()) -> SessionResult:
     """Open, check, ramp to the first pose, walk, and leave the robot in a known pose.
 
-    Sequence: ``bus.open()`` -> :func:`prepare` (ping all, read present) -> write present
+    Sequence: ``bus.open()`` -> :func:`prepare` (ping all, read present) -> ``setup_writes``
+    (:func:`write_settings`: the servos' gains; none leaves them as they are) -> write present
     as goal, then torque on (a servo enabled with a stale goal register would jump to it)
     -> ramp from present to ``frames[0]`` -> stream ``frames`` -> end.
 
@@ -429,6 +438,7 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             state.opened = True  # close even if open fails halfway: a recording may already be started
             bus.open()
             present = prepare(bus, ids)
+            write_settings(bus, setup_writes)
             # Already at the first pose (within a tick): that pose is the goal written before torque on,
             # and it counts as the walk's first frame, so a recording holds exactly the trajectory.
             at_start = int(np.max(np.abs(present - walk[0]))) <= 1

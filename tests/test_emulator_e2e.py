@@ -10,6 +10,7 @@ walk per fault, which stops within about a second of the fault.
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import time
@@ -38,6 +39,7 @@ def scs_config(tmp_path: Path) -> Path:
     text = (ROOT / "config" / "sts3215-biped.toml").read_text()
     text = text.replace('name = "sts3215-biped"', 'name = "scs0009-biped"').replace('"STS3215"', '"SCS0009"')
     text = text.replace("zero_tick = 2048", "zero_tick = 512")
+    text = re.sub(r"(?m)^\[servo\]\nfull_torque_error_deg = .*\n", "", text)  # no known gain register on an SCS0009
     path = tmp_path / "scs0009-biped.toml"
     path.write_text(text)
     return path

@@ -460,7 +460,7 @@ def test_mass_and_servo_tables_are_optional_with_a_15_kg_default(tmp_path):
 
 def test_mass_and_servo_values_are_read(tmp_path):
     text = set_top(shipped_text("xl430-biped"), "torso_kg", "0.55")
-    text += "\n[servo]\nstall_torque_nm = 1.5\nfull_torque_error_deg = 3.0\n"
+    text = text.replace("[servo]\nfull_torque_error_deg = 2.0\n", "[servo]\nstall_torque_nm = 1.5\nfull_torque_error_deg = 3.0\n")
     text = re.sub(r"(?m)^(ankle_height_m = .*)$", r"\1\nheel_back_m = 0.03", text, count=1)
     config = load_text(tmp_path, text)
     assert config.mass.torso_kg == 0.55 and config.mass.foot_kg == 0.04
@@ -473,8 +473,8 @@ def test_mass_and_servo_values_are_read(tmp_path):
     (lambda t: set_top(t, "thigh_kg", "0"), "mass.thigh_kg", ("positive",)),
     (lambda t: set_top(t, "foot_kg", '"light"'), "mass.foot_kg", ("positive number", "string")),
     (lambda t: t.replace("[mass]\n", "[mass]\ntorso_g = 400\n"), "mass.torso_g", ("unknown key", "torso_kg")),
-    (lambda t: t + "\n[servo]\nstall_torque_nm = -1.0\n", "servo.stall_torque_nm", ("positive",)),
-    (lambda t: t + "\n[servo]\nfull_torque_deg = 3.0\n", "servo.full_torque_deg",
+    (lambda t: t.replace("[servo]\n", "[servo]\nstall_torque_nm = -1.0\n"), "servo.stall_torque_nm", ("positive",)),
+    (lambda t: t.replace("[servo]\n", "[servo]\nfull_torque_deg = 3.0\n"), "servo.full_torque_deg",
      ("unknown key", "full_torque_error_deg")),
     (lambda t: re.sub(r"(?m)^(ankle_height_m = .*)$", r"\1\nheel_back_m = 0.2", t, count=1),
      "geometry.heel_back_m", ("shorter than foot_m",)),

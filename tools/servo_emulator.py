@@ -12,7 +12,8 @@ Feetech SCS/STS protocol manual):
 
 * a control table with the model's real addresses (model number, firmware, id, baud rate, return
   delay, status return level, torque enable, goal/present position, voltage, temperature, moving,
-  hardware error status);
+  hardware error status, and the gain register at its factory value: a session's gain writes stay
+  in the table, to be read back);
 * ping, read, write, reg write + action, sync write, sync read (Dynamixel 2.0 and Feetech; AX-12A
   firmware has none), bulk read and bulk write (Dynamixel 2.0), reboot; other instructions get an
   Instruction Error status; damaged packets (bad checksum/CRC) get no answer; broadcast gets no

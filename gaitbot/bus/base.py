@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 
 
 class BusError(Exception):
@@ -53,6 +54,19 @@ class ServoStatusError(BusError):
         self.fault = fault
 
 
+@dataclass(frozen=True)
+class RegisterWrite:
+    """A setting a session writes to servos before torque goes on: ``value`` as ``length`` bytes (each
+    servo's byte order) at control-table ``address`` of every servo in ``ids``; ``name`` says what the
+    register is, for messages."""
+
+    ids: tuple[int, ...]
+    address: int
+    length: int
+    value: int
+    name: str = ""
+
+
 class Bus(ABC):
     """A chain of servos on one serial bus.
 
@@ -83,6 +97,13 @@ class Bus(ABC):
     @abstractmethod
     def read_present_ticks(self, ids: Iterable[int]) -> dict[int, int]:
         """Present positions (sync read where the protocol has it); reads retry a bounded number of times."""
+
+    def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
+        """Write a setting (a gain, a lock flag) to each servo, waiting for each one's status packet.
+
+        Not for goal positions (write_goal_ticks, which the LimitGuard checks) nor torque (set_torque).
+        Backends that talk to servos implement it; others have nothing to write to."""
+        raise NotImplementedError(f"{type(self).__name__} cannot write servo registers")
 
     def __enter__(self) -> "Bus":
         self.open()

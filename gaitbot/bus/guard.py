@@ -50,6 +50,10 @@ class LimitGuard(Bus):
     def read_present_ticks(self, ids: Iterable[int]) -> dict[int, int]:
         return self.inner.read_present_ticks(ids)
 
+    def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
+        """Settings are not goals: passed on (the backend refuses a write to the goal or torque register)."""
+        self.inner.write_register(ids, address, length, value)
+
     def write_goal_ticks(self, goals: Mapping[int, int]) -> None:
         for servo_id, tick in goals.items():
             low, high = self.limits.get(servo_id, (None, None))

@@ -6,7 +6,8 @@ byte for byte what a real run would send. It parses each instruction packet with
 (written from the protocol documents, not from the SDK) and answers as the servos would:
 
 * ping: status packet (Dynamixel 2.0 adds model number and firmware version);
-* write: stored in the servo's control table, status packet unless broadcast;
+* write: stored in the servo's control table, status packet unless broadcast (the table starts with
+  the model number, the centre tick as goal and present position, and the factory gain register);
 * sync write: stored, no status packet;
 * read / sync read: status packets with the control-table bytes; present position mirrors the last
   goal position written (initially the model's centre tick).
@@ -144,6 +145,10 @@ class MockPort:
         table[model.addr_goal_position:model.addr_goal_position + model.len_goal_position] = centre
         table[model.addr_present_position:model.addr_present_position + model.len_present_position] = \
             centre[:model.len_present_position]
+        if model.gain is not None:  # the factory stiffness, until a session writes its own
+            factory = model.gain.factory_value.to_bytes(model.gain.length, model.byte_order)
+            for address in model.gain.addresses:
+                table[address:address + model.gain.length] = factory
         return table
 
     def _answer(self, raw: bytes) -> None:

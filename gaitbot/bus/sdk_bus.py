@@ -72,6 +72,9 @@ class SdkBus(Bus):
     * Any OS-level failure of the port (the adapter unplugged, the pty closed) raises
       ``PortError`` at once; nothing is retried on a dead port. Writes time out after
       ``WRITE_TIMEOUT_S`` instead of blocking.
+    * Torque and register writes (``set_torque``, ``write_register``) wait for each servo's status
+      packet and are retried like reads (rewriting the same bytes is harmless); all attempts silent
+      raise ``ServoTimeout`` naming the servo and the address.
     * Goal writes are never retried: a goal sync write has no status packet to tell success from
       loss, and the next frame supersedes it anyway.
 
@@ -224,14 +227,31 @@ class SdkBus(Bus):
         for servo_id in ids:
             self._model(servo_id)
             try:
-                self._write_byte_confirmed(servo_id, self._torque_addr, 1 if enabled else 0,
-                                           raise_status=enabled)
+                self._write_confirmed(servo_id, self._torque_addr, bytes([1 if enabled else 0]), raise_status=enabled)
             except BusError as exc:
                 if enabled:
                     raise
                 failures.append(exc)
         if failures:
             raise failures[0]
+
+    def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
+        """Write ``value`` (unsigned, ``length`` bytes in each servo's byte order) to ``address`` of each
+        servo in turn, retried like a torque write (rewriting a setting is harmless); a servo that answers
+        with error bits set raises ServoStatusError. Goal position and torque enable are refused: they go
+        through write_goal_ticks (checked by the LimitGuard) and set_torque."""
+        self._require_open()
+        if length not in (1, 2, 4) or not 0 <= int(value) < 1 << (8 * length):
+            raise ValueError(f"register write of {value} at address {address}: needs 1, 2 or 4 bytes and an "
+                             f"unsigned value that fits (got {length} bytes)")
+        for servo_id in ids:
+            model = self._model(servo_id)
+            for start, size, what in ((model.addr_goal_position, model.len_goal_position, "write_goal_ticks"),
+                                      (model.addr_torque_enable, 1, "set_torque")):
+                if address < start + size and start < address + length:
+                    raise ValueError(f"register write at address {address} ({length} bytes) would touch servo "
+                                     f"{servo_id}'s register at {start}; use {what}")
+            self._write_confirmed(servo_id, address, int(value).to_bytes(length, model.byte_order))
 
     def write_goal_ticks(self, goals: Mapping[int, int]) -> None:
         self._require_open()
@@ -401,18 +421,20 @@ class SdkBus(Bus):
                 return True
         return False
 
-    def _write_byte_confirmed(self, servo_id: int, address: int, value: int, raise_status: bool = True) -> None:
+    def _write_confirmed(self, servo_id: int, address: int, data: bytes, raise_status: bool = True) -> None:
+        """One WRITE instruction of ``data`` at ``address``, retried until the servo's status packet comes."""
         result, error = self.sdk.COMM_SUCCESS, 0
-        for _ in range(1 + self.retries):  # rewriting the same byte is harmless, so retry
+        for _ in range(1 + self.retries):  # rewriting the same bytes is harmless, so retry
             self._before_transaction()
             with self._port_guard(servo_id):
                 self._drop_stale_input()
-                result, error = self._ph.write1ByteTxRx(self.port, servo_id, address, value)
+                result, error = self._ph.writeTxRx(self.port, servo_id, address, len(data), list(data))
             self._raise_on_port_failure(result, servo_id)
             if result == self.sdk.COMM_SUCCESS:
                 break
         else:
-            raise ServoTimeout(f"servo {servo_id} on {self.port_name} did not confirm writing {value} to "
+            shown = data[0] if len(data) == 1 else f"0x{data.hex()}"
+            raise ServoTimeout(f"servo {servo_id} on {self.port_name} did not confirm writing {shown} to "
                                f"address {address} ({self._ph.getTxRxResult(result)})",
                                result_code=result, servo_id=servo_id)
         self.last_status_errors[servo_id] = error

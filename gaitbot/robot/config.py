@@ -27,6 +27,7 @@ from typing import Any
 
 from gaitbot.gait.trajectory import WALKING_JOINTS
 from gaitbot.robot.calibration import angle_rad_to_ticks
+from gaitbot.robot.servo_gains import GainError, gain_for_error
 from gaitbot.robot.servo_models import SERVO_MODELS, ServoModel
 
 try:
@@ -136,11 +137,13 @@ class MassSettings:
 
 @dataclass(frozen=True)
 class ServoSettings:
-    """Overrides of the servo models' drive figures for the simulated robot (``[servo]``, optional).
+    """The servos' drive (``[servo]``, optional).
 
-    None keeps the model's datasheet figure (gaitbot.robot.servo_models): stall torque (N m),
-    no-load speed (rev/min) and the position error at which the position loop gives full torque
-    (degrees; smaller is stiffer, see ServoModel.full_torque_error_deg)."""
+    ``full_torque_error_deg`` is a real setting: the position error (degrees) at which every servo's
+    position loop gives full output, smaller is stiffer. A session writes it to each servo's gain
+    register before torque goes on (gaitbot.robot.servo_gains); None leaves the factory gains alone.
+    ``stall_torque_nm`` (N m) and ``no_load_speed_rpm`` (rev/min) override the servo models' datasheet
+    figures (gaitbot.robot.servo_models) for the simulated robot only; None keeps them."""
 
     stall_torque_nm: float | None = None
     no_load_speed_rpm: float | None = None
@@ -363,6 +366,7 @@ class _Reader:
         joints = self.joints(data, bus)
         mass = self.mass(self.optional_table(data, "mass", _MASS_KEYS))
         servo = self.servo(self.optional_table(data, "servo", _SERVO_KEYS))
+        self.gains_settable(joints, servo)
         return RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
                            mass=mass, servo=servo)
 
@@ -378,6 +382,17 @@ class _Reader:
     def servo(self, t: dict) -> ServoSettings:
         return ServoSettings(**{k: self.number(t, k, "servo", positive=True) if k in t else None
                                 for k in _SERVO_KEYS})
+
+    def gains_settable(self, joints: tuple[JointConfig, ...], servo: ServoSettings) -> None:
+        """A stiffness asked for must be one every servo's gain register can hold (it is written to all)."""
+        if servo.full_torque_error_deg is None:
+            return
+        for joint in joints:
+            try:
+                gain_for_error(joint.model, servo.full_torque_error_deg)
+            except GainError as exc:
+                where = f"joints.{joint.name} ({joint.model.name})"
+                raise self.fail("servo.full_torque_error_deg", f"{where}: {exc}") from None
 
     def geometry(self, t: dict) -> Geometry:
         f = "geometry"

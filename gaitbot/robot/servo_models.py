@@ -9,6 +9,54 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+#: Laws that turn a gain register value into the position error (deg) at which the loop gives full output.
+INVERSE_GAIN = "inverse"  # error_deg = error_deg_times_value / value (a P gain)
+COMPLIANCE_SLOPE = "compliance_slope"  # error_deg = representative step (2, 4, ..., 128) x deg_per_unit
+SLOPE_STEPS = tuple(2 ** n for n in range(1, 8))  # 2, 4, ..., 128 (e-Manual "Compliance Slope")
+
+
+@dataclass(frozen=True)
+class GainRegister:
+    """The control-table register(s) that set how stiff a servo's position loop is, and their scale.
+
+    Every address in ``addresses`` (``length`` bytes each, the model's byte order) gets the same value,
+    from ``min_value`` to ``max_value``; ``factory_value`` is what the servo holds after power-on.
+    ``law`` says how a value maps to the position error at which the loop gives full output:
+    INVERSE_GAIN, error_deg = ``error_deg_times_value`` / value; COMPLIANCE_SLOPE, the value is used as
+    its representative step (2, 4, ..., 128) and error_deg = step x ``deg_per_unit``.
+    ``before``: (address, length, value, register name) writes that must precede it (Feetech: the
+    EEPROM lock on, so that the gain is not saved and lasts until power-off). ``assumed``: the scale
+    is not documented by the maker (said so wherever the gain is reported).
+    """
+
+    name: str
+    addresses: tuple[int, ...]
+    length: int
+    min_value: int
+    max_value: int
+    factory_value: int
+    law: str
+    error_deg_times_value: float = 0.0
+    deg_per_unit: float = 0.0
+    before: tuple[tuple[int, int, int, str], ...] = ()
+    assumed: bool = False
+    source: str = ""
+
+    def full_torque_error_deg(self, value: int) -> float:
+        """The position error (deg) at which the loop gives full output with ``value`` in the register:
+        any byte it may hold (a P gain of 0: infinite, no stiffness; a slope: its step's representative)."""
+        if self.law == COMPLIANCE_SLOPE:
+            step = min(SLOPE_STEPS[-1], 1 << (max(int(value), SLOPE_STEPS[0]).bit_length() - 1))
+            return step * self.deg_per_unit
+        if self.law != INVERSE_GAIN:
+            raise ValueError(f"unknown gain law {self.law!r}")
+        return math.inf if value <= 0 else self.error_deg_times_value / value
+
+    @property
+    def factory_error_deg(self) -> float:
+        """The stiffness the servo has after power-on (its factory register value), in the same terms."""
+        return self.full_torque_error_deg(self.factory_value)
+
 
 @dataclass(frozen=True)
 class ServoModel:
@@ -45,6 +93,9 @@ class ServoModel:
     # linearly with the error up to the stall torque).
     stall_torque_nm: float
     full_torque_error_deg: float
+    # The register the session writes to set that stiffness (``[servo] full_torque_error_deg``); None
+    # when gaitbot knows no register with a usable scale for the model.
+    gain: GainRegister | None = None
 
     @property
     def ticks_per_rad(self) -> float:
@@ -63,14 +114,55 @@ class ServoModel:
 
 
 # Dynamixel X series in position mode: a PID on the position error in pulses whose output is PWM,
-# KPP = Position P Gain / 128 (factory 800), PWM Limit 885 = 100 % (e-Manual, XL430-W250 control
-# table, "Position PID Gain" and "PWM Limit"): full PWM at 885 / (800 / 128) = 141.6 pulses =
-# 12.4 deg. (MuJoCo Menagerie's ROBOTIS OP3 model gives its XM430 joints kp 21.1 N m/rad against
-# a 4.1 N m stall torque: full torque at 11.1 deg, the same order.)
-_X_FULL_TORQUE_ERROR_DEG = 885 / (800 / 128) * 360 / 4096
-# AX-12A: factory CW/CCW Compliance Slope 32 (e-Manual, AX-12A control table): the output falls
-# off over the last 32 units (0.29 deg each) before the goal, i.e. full torque beyond 9.4 deg.
-_AX_FULL_TORQUE_ERROR_DEG = 32 * 300 / 1023
+# KPP = Position P Gain / 128, PWM Limit 885 = 100 % (e-Manual "Position PID Gain(84, 82, 80)" and
+# "PWM Limit(36)"): the output is full at 885 / KPP pulses = 885 x 128 / gain pulses, so
+# error_deg x gain = 885 x 128 x 360 / 4096 = 9956 deg. Factory gains (e-Manual control tables, RAM
+# area): XM430-W350 800 -> 141.6 pulses = 12.4 deg; XL430-W250 640 (with Position D Gain 4000) ->
+# 177 pulses = 15.6 deg. (MuJoCo Menagerie's ROBOTIS OP3 model gives its XM430 joints kp 21.1 N m/rad
+# against a 4.1 N m stall torque: full torque at 11.1 deg, the same order.)
+_X_ERROR_DEG_TIMES_GAIN = 885 * 128 * 360 / 4096
+_X_FACTORY_GAIN = {"XM430-W350": 800, "XL430-W250": 640}
+
+
+def _x_gain(model_name: str) -> GainRegister:
+    """Position P Gain(84) of one X series model (only the factory value differs)."""
+    return GainRegister(
+        name="Position P Gain", addresses=(84,), length=2, min_value=1, max_value=16383,
+        factory_value=_X_FACTORY_GAIN[model_name], law=INVERSE_GAIN, error_deg_times_value=_X_ERROR_DEG_TIMES_GAIN,
+        source=f"ROBOTIS e-Manual {model_name} control table: Position P Gain(84), 2 bytes, RAM, 0..16383")
+
+
+_XL430_GAIN, _XM430_GAIN = _x_gain("XL430-W250"), _x_gain("XM430-W350")
+
+# AX-12A: CW/CCW Compliance Slope (28, 29; 1 byte each, RAM, factory 32; e-Manual AX-12A control table
+# and "Compliance Slope"): a value acts as its step's representative 2, 4, 8, 16, 32, 64 or 128, and the
+# output falls off over that many units (300/1023 deg each) before the goal: full torque beyond
+# 32 x 0.293 = 9.4 deg at the factory slope.
+_AX_GAIN = GainRegister(
+    name="CW/CCW Compliance Slope", addresses=(28, 29), length=1, min_value=2, max_value=128, factory_value=32,
+    law=COMPLIANCE_SLOPE, deg_per_unit=300 / 1023,
+    source="ROBOTIS e-Manual AX-12A control table: CW/CCW Compliance Slope(28, 29), 1 byte each, RAM, "
+           "steps 2..128")
+
+# Feetech STS3215: P coefficient (21, 1 byte, factory 32; SMS/STS memory table). Its scale in degrees
+# is not documented: ASSUMED to be the X series' at factory gain (full output at 12.4 deg with P = 32)
+# and P proportional to 1 / error. Address 21 is in the EEPROM area: with the Lock flag (55, SRAM) at 1
+# a write there is not saved and lasts until power-off (Feetech's SCServo library: LockEprom writes 1 to
+# address 55, "turn off EPROM saving"; unLockEprom writes 0). Lock is written to 1 first, so the gain
+# never outlives a power cycle whatever the servo was left at; that the new P takes effect at once,
+# without a restart, is taken from the memory table's RW access and not verified on hardware.
+_STS_FACTORY_P = 32
+_STS_GAIN = GainRegister(
+    name="P coefficient", addresses=(21,), length=1, min_value=1, max_value=255, factory_value=_STS_FACTORY_P,
+    law=INVERSE_GAIN, error_deg_times_value=_STS_FACTORY_P * _X_ERROR_DEG_TIMES_GAIN / _X_FACTORY_GAIN["XM430-W350"],
+    before=((55, 1, 1, "Lock"),), assumed=True,
+    source="Feetech SMS/STS memory table: P coefficient(21), 1 byte, factory 32; Lock(55)")
+
+
+# Models without a usable gain register keep the X series figure at its factory gain 800 as their
+# (assumed) stiffness: the XL-320's P Gain(29) and the SCS0009's P coefficient(21) have no documented
+# scale, and the SCS0009's factory value is not known either (the SCS15 manual gives 15, not 32).
+_X_FULL_TORQUE_ERROR_DEG = _X_ERROR_DEG_TIMES_GAIN / _X_FACTORY_GAIN["XM430-W350"]
 
 
 _X_SERIES = dict(
@@ -98,14 +190,14 @@ SERVO_MODELS: dict[str, ServoModel] = {
         # No-load speed 57 rev/min at 11.1 V (47 at 9 V, 61 at 12 V).
         # Stall torque 1.4 N m at 11.1 V (1.0 at 9 V, 1.5 at 12 V).
         ServoModel(name="XL430-W250", no_load_speed_rpm=57.0, stall_torque_nm=1.4,
-                   full_torque_error_deg=_X_FULL_TORQUE_ERROR_DEG,
+                   full_torque_error_deg=_XL430_GAIN.factory_error_deg, gain=_XL430_GAIN,
                    source="ROBOTIS e-Manual XL430-W250 control table and specifications (57 rpm, 1.4 N m @ 11.1 V)",
                    **_X_SERIES),
         # Verified against emanual.robotis.com/docs/en/dxl/x/xm430-w350/: model number 1020; same
         # X-series addresses (64 / 112 / 116 / 132). No-load speed 46 rev/min at 12.0 V (43 @ 11.1 V).
         # Stall torque 4.1 N m at 12 V.
         ServoModel(name="XM430-W350", no_load_speed_rpm=46.0, stall_torque_nm=4.1,
-                   full_torque_error_deg=_X_FULL_TORQUE_ERROR_DEG,
+                   full_torque_error_deg=_XM430_GAIN.factory_error_deg, gain=_XM430_GAIN,
                    source="ROBOTIS e-Manual XM430-W350 control table and specifications (46 rpm, 4.1 N m @ 12 V)",
                    **_X_SERIES),
         # Verified against emanual.robotis.com/docs/en/dxl/x/xl320/: Protocol 2.0 only, model 350,
@@ -123,7 +215,7 @@ SERVO_MODELS: dict[str, ServoModel] = {
         # Stall torque 1.5 N m at 12 V.
         ServoModel(name="AX-12A", family="dynamixel", protocols=(1.0,), addr_present_position=36,
                    len_present_position=2, no_load_speed_rpm=59.0, stall_torque_nm=1.5,
-                   full_torque_error_deg=_AX_FULL_TORQUE_ERROR_DEG,
+                   full_torque_error_deg=_AX_GAIN.factory_error_deg, gain=_AX_GAIN,
                    source="ROBOTIS e-Manual AX-12A control table and specifications (59 rpm, 1.5 N m @ 12 V)",
                    **_AX_TABLE),
         # Verified against the Feetech SMS/STS memory table as transcribed in LeRobot
@@ -134,17 +226,16 @@ SERVO_MODELS: dict[str, ServoModel] = {
         # 7.4 V ST3215 is listed at 0.192 s/60 deg = 52 rpm. 45 rpm is kept: the lower figure is the
         # conservative one for speed-limit checks.
         # Stall torque: 19.5 kg cm = 1.9 N m for the 7.4 V ST3215 (30 kg cm at 12 V); the lower figure is
-        # kept, like the speed. Feetech does not document the scale of its P coefficient (factory 32):
-        # the X series figure is assumed.
+        # kept, like the speed. Its stiffness: _STS_GAIN above (P coefficient, scale assumed).
         ServoModel(name="STS3215", resolution_ticks=4096, range_deg=360.0, min_tick=0, max_tick=4095,
                    centre_tick=2048, wraps=True, byte_order="little", no_load_speed_rpm=45.0,
-                   stall_torque_nm=1.9, full_torque_error_deg=_X_FULL_TORQUE_ERROR_DEG,
+                   stall_torque_nm=1.9, full_torque_error_deg=_STS_GAIN.factory_error_deg, gain=_STS_GAIN,
                    source="Feetech SMS/STS memory table (via LeRobot tables.py); STS3215 datasheet 45 rpm",
                    **_FEETECH_TABLE),
         # Verified against the Feetech SCSCL memory table (LeRobot SCS_SERIES_CONTROL_TABLE): model 1284,
         # same addresses 40 / 42 / 46 / 56; SCS stores words high byte first (SCS_END 1).
         # SC09/SCS0009 product page: 300 deg over 0..1023 (0.293 deg/step), 0.1 s/60 deg = 100 rpm at 6 V.
-        # Stall torque 2.3 kg cm = 0.23 N m at 6 V (SC09 product page); P coefficient scale assumed as above.
+        # Stall torque 2.3 kg cm = 0.23 N m at 6 V (SC09 product page); no gain register (see above).
         ServoModel(name="SCS0009", resolution_ticks=1024, range_deg=300.0, min_tick=0, max_tick=1023,
                    centre_tick=512, wraps=False, byte_order="big", no_load_speed_rpm=100.0,
                    stall_torque_nm=0.23, full_torque_error_deg=_X_FULL_TORQUE_ERROR_DEG,

@@ -29,6 +29,10 @@ max_torque_fraction
 max_tracking_error_deg
     The largest |goal - joint angle| over the walking joints at the end of each frame, i.e. just
     before the next goal replaces the present one.
+full_torque_error_deg
+    Per walking joint (hip, knee, ankle left, then right), the stiffness its simulated servo walked
+    with: the position error at which it gave full torque, as read from its gain register (the value
+    the session wrote, or the factory one) at the last sample of the walk.
 """
 
 from __future__ import annotations
@@ -78,6 +82,7 @@ class SimReport:
     max_tracking_error_deg: float
     simulated_s: float
     free_pitch: bool
+    full_torque_error_deg: tuple[float, ...] = ()
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -91,7 +96,14 @@ class SimReport:
                 f"{planned:.3f} m planned{share}; {fall}; max slip {self.max_slip_m * 1e3:.2f} mm; "
                 f"scuff {100 * self.scuff_fraction:.1f}% of swing time; max torque "
                 f"{100 * self.max_torque_fraction:.0f}% of stall; max tracking error "
-                f"{self.max_tracking_error_deg:.2f} deg.")
+                f"{self.max_tracking_error_deg:.2f} deg{self._stiffness()}.")
+
+    def _stiffness(self) -> str:
+        if not self.full_torque_error_deg:
+            return ""
+        low, high = min(self.full_torque_error_deg), max(self.full_torque_error_deg)
+        spread = f"{low:.2f}" if high - low < 5e-3 else f"{low:.2f} to {high:.2f}"
+        return f"; servos at full torque from {spread} deg of error"
 
 
 class WalkMeter:
@@ -108,6 +120,7 @@ class WalkMeter:
         self.touch_share: list[np.ndarray] = []
         self.effort: list[float] = []
         self.tracking_deg: list[float] = []
+        self.stiffness_deg: tuple[float, ...] = ()
         self.fell_at_s: float | None = None
         self.fall_reason: str | None = None
         self.max_slip_m = 0.0
@@ -129,6 +142,7 @@ class WalkMeter:
         self.effort.append(float(effort.max()))
         error = np.abs(robot.goals_rad() - robot.joint_angles_rad())
         self.tracking_deg.append(math.degrees(float(error.max())))
+        self.stiffness_deg = tuple(float(e) for e in robot.full_torque_error_deg)
         contacts = robot.floor_contacts()
         self._check_fall(robot, t, torso, contacts)
         self._measure_slip(robot, contacts)
@@ -176,7 +190,8 @@ class WalkMeter:
             max_slip_m=float(self.max_slip_m), scuff_fraction=self._scuff_fraction(times, plan),
             max_torque_fraction=float(max(self.effort, default=0.0)),
             max_tracking_error_deg=float(max(self.tracking_deg, default=0.0)),
-            simulated_s=float(times[-1]) if times.size else 0.0, free_pitch=free_pitch)
+            simulated_s=float(times[-1]) if times.size else 0.0, free_pitch=free_pitch,
+            full_torque_error_deg=self.stiffness_deg)
 
     def _scuff_fraction(self, times: np.ndarray, plan: WalkPlan) -> float:
         """Touching time over window time; a sample at t covers the frame (t - frame, t]."""

@@ -20,8 +20,11 @@ proportional position loop, which is what these servos are:
 
     torque = clip(kp * (goal - angle), -stall, +stall) - b * speed,    b = stall / no_load_speed
 
-kp = stall torque / full-torque error (ServoModel.full_torque_error_deg, the factory gain; ``[servo]``
-overrides). The back-EMF term b * speed is the joint's damping: it gives the datasheet no-load speed
+kp = stall torque / full-torque error. The model starts at the factory gain (ServoModel.full_torque_error_deg);
+what the session writes to a servo's gain register then sets it (sim_bus.py reads the register, the
+robot's ``set_full_torque_error``), so ``[servo] full_torque_error_deg`` reaches the simulated robot only
+through the packets a real robot would get. ``[servo]`` stall torque and no-load speed override the
+datasheet figures. The back-EMF term b * speed is the joint's damping: it gives the datasheet no-load speed
 at full effort and the motor's straight torque-speed line below it. The gearbox's reflected rotor
 inertia (armature) is b * MOTOR_TIME_CONSTANT_S. Joint ranges are the config's min_deg..max_deg.
 Held joints (e.g. the ax12a-biped's hip roll) are not modelled: a planar model has no roll; the sim
@@ -85,7 +88,8 @@ class JointDrive:
 
 
 def joint_drives(config: RobotConfig) -> tuple[JointDrive, ...]:
-    """The six walking joints' drives: each joint's servo model, with ``[servo]`` overrides applied."""
+    """The six walking joints' drives: each joint's servo model at its factory gain, with the ``[servo]``
+    stall torque and no-load speed overrides applied (the gain is the control table's business)."""
     over = config.servo
     drives = []
     for joint in config.walking_joints:
@@ -94,9 +98,7 @@ def joint_drives(config: RobotConfig) -> tuple[JointDrive, ...]:
         drives.append(JointDrive(
             name=joint.name, min_deg=joint.min_deg, max_deg=joint.max_deg,
             stall_torque_nm=over.stall_torque_nm if over.stall_torque_nm is not None else model.stall_torque_nm,
-            no_load_speed_rad_s=rpm * 2.0 * math.pi / 60.0,
-            full_torque_error_deg=(over.full_torque_error_deg if over.full_torque_error_deg is not None
-                                   else model.full_torque_error_deg)))
+            no_load_speed_rad_s=rpm * 2.0 * math.pi / 60.0, full_torque_error_deg=model.full_torque_error_deg))
     return tuple(drives)
 
 

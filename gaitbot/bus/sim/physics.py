@@ -10,6 +10,7 @@ each sole touches the floor, for the observers to read and reset.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -24,7 +25,8 @@ class SimRobot:
 
     Walking joints are indexed 0..5 in the config's (WALKING_JOINTS) order everywhere here.
     ``effort_peak``: per servo, the largest |commanded torque| / stall torque since the observers
-    last reset it (1.0 = saturated); ``touch_steps``: per sole (left, right), timesteps in contact.
+    last reset it (1.0 = saturated); ``touch_steps``: per sole (left, right), timesteps in contact;
+    ``full_torque_error_deg``: per servo, its stiffness now (factory until a gain is written).
     """
 
     def __init__(self, config: RobotConfig, rate_hz: float, free_pitch: bool = False) -> None:
@@ -41,6 +43,7 @@ class SimRobot:
         self.qpos_index = np.array([model.joint(d.name).qposadr[0] for d in self.drives])
         self.actuator_index = np.array([model.actuator(d.name).id for d in self.drives])
         self.stall_nm = np.array([d.stall_torque_nm for d in self.drives])
+        self.full_torque_error_deg = np.array([d.full_torque_error_deg for d in self.drives])
         self._kp = model.actuator_gainprm[self.actuator_index, 0].copy()
         self.torque_on = np.zeros(len(self.drives), dtype=bool)
         self.floor_geom = model.geom("floor").id
@@ -67,6 +70,13 @@ class SimRobot:
 
     def goals_rad(self) -> np.ndarray:
         return self.data.ctrl[self.actuator_index].copy()
+
+    def set_full_torque_error(self, joint: int, error_deg: float) -> None:
+        """The servo's stiffness, as its gain register sets it: full torque at ``error_deg`` degrees of
+        position error (kp = stall / error; an infinite error, a gain of 0, pushes nothing)."""
+        self.full_torque_error_deg[joint] = error_deg
+        self._kp[joint] = self.stall_nm[joint] / math.radians(error_deg)
+        self.set_torque(joint, bool(self.torque_on[joint]))
 
     def set_torque(self, joint: int, enabled: bool) -> None:
         """A servo with torque off pushes nothing (its gearmotor's back-EMF damping stays)."""

@@ -9,6 +9,9 @@ servos would) with physics behind the control tables instead of ideal servos:
 * a goal-position write becomes the joint's actuator target (ticks -> angle by the robot's
   calibration, the inverse of what the streamer did);
 * a torque-enable write switches the joint's servo on or off;
+* a write to the model's gain register (Position P Gain, Compliance Slope, P coefficient) sets the
+  joint's stiffness from the register's bytes (GainRegister.full_torque_error_deg, gaitbot.robot.servo_models); the
+  table starts with the factory value, so a session that writes no gain walks at factory stiffness;
 * a present-position read answers the simulated joint angle (angle -> ticks by the calibration).
 
 Joints the model does not have (held joints such as the ax12a-biped's hip roll) stay ideal mock
@@ -80,6 +83,11 @@ class SimPort(MockPort):
             self.robot.set_goal(joint, float(ticks_to_angle_rad(ticks, *self._calibration[servo_id])))
         if _overlaps(address, len(data), model.addr_torque_enable, 1):
             self.robot.set_torque(joint, bool(table[model.addr_torque_enable]))
+        gain = model.gain
+        if gain is not None and any(_overlaps(address, len(data), a, gain.length) for a in gain.addresses):
+            # One stiffness per joint in a planar model: the softer of the registers (AX: CW and CCW slope).
+            values = [int.from_bytes(table[a:a + gain.length], model.byte_order) for a in gain.addresses]
+            self.robot.set_full_torque_error(joint, max(gain.full_torque_error_deg(v) for v in values))
 
 
 def _overlaps(start: int, length: int, field_start: int, field_length: int) -> bool:
