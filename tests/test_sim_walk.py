@@ -47,7 +47,7 @@ def fixed_robot(name: str, tmp_path: Path) -> Path:
     than factory (full torque at 2 deg) and the ankle a third of the foot ahead of the heel."""
     text = (CONFIG_DIR / f"{name}.toml").read_text()
     foot = float(re.search(r"^foot_m = ([0-9.]+)", text, re.M).group(1))
-    text = re.sub(r"^(ankle_height_m = .*)$", rf"\1\nheel_back_m = {foot / 3:.4f}", text, count=1, flags=re.M)
+    text = re.sub(r"^heel_back_m = .*$", f"heel_back_m = {foot / 3:.4f}", text, count=1, flags=re.M)
     path = tmp_path / f"{name}-fixed.toml"
     stiff = "" if re.search(r"^full_torque_error_deg = 2\.0$", text, re.M) else "\n[servo]\nfull_torque_error_deg = 2.0\n"
     path.write_text(text + stiff)  # the shipped configs now set it themselves
