@@ -185,10 +185,13 @@ def terrain_settings(source: GaitSource, course, clearance_override: float | Non
     from gaitbot.gait.terrain.walk import TerrainSettings, default_weights
 
     leg = source.geometry.leg_length
-    lo = hi = None
+    lo = hi = speed = accel = None
     if source.robot is not None:
-        lo = tuple(math.radians(j.min_deg) for j in source.robot.joints[:3])
-        hi = tuple(math.radians(j.max_deg) for j in source.robot.joints[:3])
+        pairs = list(zip(source.robot.joints[:3], source.robot.joints[3:6]))  # (left, right) hip, knee, ankle
+        lo = tuple(math.radians(max(a.min_deg, b.min_deg)) for a, b in pairs)
+        hi = tuple(math.radians(min(a.max_deg, b.max_deg)) for a, b in pairs)
+        speed = tuple(math.radians(min(a.max_velocity_dps, b.max_velocity_dps)) for a, b in pairs)
+        accel = tuple(math.radians(min(a.max_acceleration_dps2, b.max_acceleration_dps2)) for a, b in pairs)
     clearance = course.clearance_m if course.clearance_m is not None else source.settings.clearance
     if clearance_override is not None:
         clearance = clearance_override
@@ -196,7 +199,7 @@ def terrain_settings(source: GaitSource, course, clearance_override: float | Non
     return TerrainSettings(margin=course.margin_m, clearance=clearance, max_step=max_step,
                            max_rise=course.max_rise_m if course.max_rise_m is not None else 0.25 * leg,
                            max_travel=max_step, weights=course.weights or default_weights(lo, hi),
-                           joint_lo=lo, joint_hi=hi)
+                           joint_lo=lo, joint_hi=hi, joint_speed=speed, joint_accel=accel)
 
 
 def build_terrain_walk(args):

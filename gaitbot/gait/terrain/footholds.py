@@ -104,8 +104,8 @@ def plan_footholds(terrain: Terrain, start: float, end: float, limits: FootholdL
     cost[0, 0] = 0.0
     d_rear = np.arange(w + 1)[:, None]  # rear offset behind the stance heel
     ahead = np.arange(w + 1)[None, :]  # next heel ahead of the stance heel
-    for j in range(target):
-        row = cost[j]
+    for j, zero_only in ((j, z) for j in range(target) for z in (True, False)):
+        row = cost[j].copy()
         if not np.isfinite(row).any() or not ok_pos[j]:
             continue
         k = j + ahead  # (1, w+1)
@@ -119,7 +119,7 @@ def plan_footholds(terrain: Terrain, start: float, end: float, limits: FootholdL
         lo2, hi2 = np.minimum(surf[rear], surf[kk]), np.maximum(surf[rear], surf[kk])
         valid = (k_ok & ok_pos[kk] & (step <= longest + 1e-9) & pair_ok[lo1, hi1] & pair_ok[lo2, hi2]
                  & ((k - rear <= travel_w) | (same & (surf[rear] == surf[j]) & (k - rear <= 2 * flat_w)))
-                 & np.isfinite(row)[:, None] & ~((ahead == 0) & (d_rear == 0)))
+                 & np.isfinite(row)[:, None] & ~((ahead == 0) & (d_rear == 0)) & ((ahead == 0) | (not zero_only)))
         pref = PREFERRED_SHARE * longest
         c = row[:, None] + 1.0 + EVENNESS * np.where(ahead > 0, ((step - pref) / pref) ** 2, 0.5)
         c = np.where(valid, c, np.inf)
