@@ -175,6 +175,6 @@ def test_cli_unwalkable_obstacle_exit_2(tmp_path, capsys):
                     "height_m = 0.15\n")
     assert main(["plan", "--terrain", str(wall)]) == 2
     err = capsys.readouterr().err
-    assert str(wall) in err and "cannot walk past x = 0.3" in err and "stands 0.150 m above" in err
+    assert f"{wall}: tread 1: stands 0.15 m above its neighbours" in err and "max 0.0425 m for xl430-biped" in err
     with pytest.raises(SystemExit):
         main(["plan", "--terrain", str(wall), "--steps", "0.1"])

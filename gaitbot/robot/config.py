@@ -84,6 +84,16 @@ class GaitSettings:
 
 
 @dataclass(frozen=True)
+class TerrainReach:
+    """The optional ``[terrain]`` table: what one step can do between surfaces (metres), as measured by
+    tools/terrain_envelope.py: highest rise, deepest drop, widest gap stepped over on the level."""
+
+    max_rise_m: float
+    max_drop_m: float
+    max_gap_m: float
+
+
+@dataclass(frozen=True)
 class BusSettings:
     """The serial bus. ``protocol`` is the Dynamixel protocol version; Feetech buses always get 1.0,
     the one (Dynamixel-1.0-shaped) protocol Feetech servos speak (servo_models lists them as (1.0,))."""
@@ -126,6 +136,7 @@ class RobotConfig:
     gait: GaitSettings
     bus: BusSettings
     joints: tuple[JointConfig, ...]
+    terrain: TerrainReach | None = None
 
     @property
     def walking_joints(self) -> tuple[JointConfig, ...]:
@@ -245,7 +256,8 @@ def load_robot_config(path: str | Path, *, extra_checks: Iterable[ConfigCheck] =
     return config
 
 
-_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints")
+_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "terrain")
+_TERRAIN_KEYS = ("max_rise_m", "max_drop_m", "max_gap_m")
 _ROBOT_KEYS = ("name",)
 _GEOMETRY_KEYS = ("thigh_m", "shank_m", "foot_m", "hip_width_m", "ankle_height_m")
 _GAIT_KEYS = ("cycle_s", "max_step_m", "clearance_m", "rate_hz")
@@ -326,7 +338,12 @@ class _Reader:
         gait = self.gait(self.table(data, "gait", "gait", _GAIT_KEYS))
         bus = self.bus(self.table(data, "bus", "bus", _BUS_KEYS))
         joints = self.joints(data, bus)
-        return RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints)
+        terrain = None
+        if "terrain" in data:
+            t = self.table(data, "terrain", "terrain", _TERRAIN_KEYS)
+            terrain = TerrainReach(*(self.number(t, key, "terrain", non_negative=True) for key in _TERRAIN_KEYS))
+        return RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
+                           terrain=terrain)
 
     def geometry(self, t: dict) -> Geometry:
         f = "geometry"

@@ -10,6 +10,7 @@ to fit once the pelvis is known (swing.py).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -32,12 +33,12 @@ class LegRange:
     speed: tuple[float, float, float] | None = None  # rad/s, hip, knee, ankle
     accel: tuple[float, float, float] | None = None  # rad/s^2
 
-    @property
+    @cached_property
     def reach(self) -> float:
         """Longest hip-to-ankle distance (the knee bent min_knee, away from the straight-leg singularity)."""
         return self.geometry.leg_length * crouch_leg_scale(self.geometry, self.min_knee)
 
-    @property
+    @cached_property
     def reach_min(self) -> float:
         knee = self.joint_hi[1] - self.spare if self.joint_hi is not None else FREE_KNEE_RAD
         return self.geometry.leg_length * crouch_leg_scale(self.geometry, knee)
@@ -70,17 +71,21 @@ class LegRange:
         within its reach and ranges: 0 where it can; else the distance beyond the reach in leg lengths
         plus the angles beyond the ranges in radians. ``check_ankle`` (bool or (n,) bools) says where the
         ankle's range counts. The size lets a search find its way to a feasible point."""
+        return self.check(pose, root, check_ankle)[0]
+
+    def check(self, pose, root, check_ankle=True):
+        """(``excess``, the leg angles (n, 3) by IK with an out-of-reach foot pulled back to the reach)."""
         pose, root = np.atleast_2d(pose), np.atleast_2d(root)
         rel = pose[:, :2] - root
-        d = np.hypot(rel[:, 0], rel[:, 1])
+        d = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-12)
         out = (np.maximum(d - self.reach, 0.0) + np.maximum(self.reach_min - d, 0.0)) / self.geometry.leg_length
+        q = leg_ik(self.geometry, rel * np.minimum(1.0, self.reach / d)[:, None], pose[:, 2] + np.zeros(len(rel)))
         if self.joint_lo is None:
-            return out
-        q = self.angles(pose, root)
+            return out, q
         lo, hi = np.asarray(self.joint_lo) + self.spare, np.asarray(self.joint_hi) - self.spare
         beyond = np.maximum(lo - q, 0.0) + np.maximum(q - hi, 0.0)
         beyond[:, 2] *= np.broadcast_to(np.asarray(check_ankle, dtype=bool), (len(rel),))
-        return out + beyond.sum(axis=1)
+        return out + beyond.sum(axis=1), q
 
     def fits(self, pose, root, check_ankle=True) -> np.ndarray:
         """Per row: can the leg from a hip at ``root`` (n, 2) put its foot at ``pose`` (n, 3)?"""
@@ -88,7 +93,4 @@ class LegRange:
 
     def angles(self, pose, root):
         """Leg angles (n, 3) by IK; a foot out of reach is pulled back to the reach (callers test ``fits``)."""
-        pose, root = np.atleast_2d(pose), np.atleast_2d(root)
-        rel = pose[:, :2] - root
-        d = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-12)
-        return leg_ik(self.geometry, rel * np.minimum(1.0, self.reach / d)[:, None], pose[:, 2] + np.zeros(len(rel)))
+        return self.check(pose, root)[1]

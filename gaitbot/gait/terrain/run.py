@@ -30,6 +30,7 @@ from .legs import LegRange
 from .pelvis import Knot, PelvisPath
 from .search import Region, SearchResult, brute_force, two_level_search
 from .step import TerrainStepSegment
+from .swing import warp
 
 MS_KNEE_RAD = np.radians(20.0)  # the pelvis at mid-stance is no higher than this stance knee bend allows
 MS_X_WEIGHT = 1.0  # how much pelvis height a knot gives up per metre nearer its preferred x
@@ -124,7 +125,21 @@ class TerrainRun:
         self.path = PelvisPath(self.knots)
         for seg, w in zip(segments, self.warps):
             seg.pelvis = self.path
-            seg.finalize_swing(w)
+            seg.finalize_swing(self._dense_warp(seg, w))
+
+    def _dense_warp(self, seg: TerrainStepSegment, chosen):
+        """The swing timing checked at every frame on the final path (the search samples more sparsely): the
+        one chosen if it holds there, else the best at that density."""
+        dense = seg.swing_frames()
+        committed = [chosen] if chosen is not None else []
+        for w in committed:
+            s = np.linspace(0.0, 1.0, dense)
+            poses, _ = seg.swing.fitted(warp(s, *w)[None], self.path(seg.swing_time(s))[None])
+            excess, q = self.swing_legs.check(poses[0], self.path(seg.swing_time(s)), False)
+            dt = seg.duration * (1.0 - seg.u_ds) / (dense - 1)
+            if excess.sum() + self.swing_legs.motion_excess(q[None], dt)[0] <= 0.0:
+                return w
+        return seg.feasible_warp(self.path, self.swing_legs, samples=dense)[0]
 
     # --- feet of the whole run -------------------------------------------------------------------
     def _feet(self, t):
@@ -143,17 +158,22 @@ class TerrainRun:
                 right[inside], left[inside], sup_r[inside], sup_l[inside] = stance, other, True, other_sup
         return left, right, sup_l, sup_r
 
-    def _supports_excess(self, roots, feet) -> float:
+    def _supports_excess(self, roots, feet, angles: list | None = None) -> float:
         """How far the pelvis samples are from feasible for the supporting feet (0 if they all fit): each
         supporting foot within its leg's reach and ranges, and the pelvis never turning back (it may still
         be moving backward at the start, as handed over, but once it moves forward it keeps doing so: no
-        loops)."""
+        loops). The legs' angles (left, right) are appended to ``angles`` if given."""
         left, right, sup_l, sup_r = feet
         dx = np.diff(roots[:, 0])
         forward = np.nonzero(dx >= 0.0)[0]
-        back = float(-np.minimum(dx[forward[0]:] + BACKWARD_TOL, 0.0).sum()) if len(forward) else 0.0
-        return (back / self.ctx.geometry.leg_length + float(self.legs.excess(left[sup_l], roots[sup_l]).sum())
-                + float(self.legs.excess(right[sup_r], roots[sup_r]).sum()))
+        total = float(-np.minimum(dx[forward[0]:] + BACKWARD_TOL, 0.0).sum()) if len(forward) else 0.0
+        total /= self.ctx.geometry.leg_length
+        for pose, sup in ((left, sup_l), (right, sup_r)):
+            excess, q = self.legs.check(pose, roots)
+            total += float(excess[sup].sum())
+            if angles is not None:
+                angles.append(q)
+        return total
 
     # --- knots ---------------------------------------------------------------------------------------
     def _ms_candidates(self, seg: TerrainStepSegment) -> list[Knot]:
@@ -222,8 +242,11 @@ class TerrainRun:
         xs, ys = np.linspace(lo_x, hi_x, 25), y_top - np.linspace(0.0, 0.35 * g.leg_length, 36)
         candidates = sorted(((y - MS_X_WEIGHT * abs(x - mid), x, y) for x in xs for y in ys), reverse=True)
         head = self.knots[:-1]
+        handed = np.array([stance, landed])
         for _, x, y in candidates:
             end = Knot(t_end, (float(x), float(y)), (_slope(last_ms, Knot(t_end, (x, y), (0, 0), "")), 0.0), "end")
+            if not self.knot_legs.fits(handed, np.array([[x, y], [x, y]])).all():
+                continue  # the segment taking over (the flat walker, or the settle) wants room to move on
             if self._supports_excess(PelvisPath([last_ms, end])(t), feet) > 0.0:
                 continue
             w, excess = seg.feasible_warp(PelvisPath([*head, last_ms, end]), self.swing_legs)
@@ -294,10 +317,10 @@ class TerrainRun:
         def cost(p) -> float:
             path = PelvisPath([*head, prev, knot(p), nxt])
             roots = path(t)
-            excess = self._supports_excess(roots, feet) + swings_excess(path)
+            angles: list = []
+            excess = self._supports_excess(roots, feet, angles) + swings_excess(path)
             total = 0.0
-            for pose, sup in ((left, sup_l), (right, sup_r)):
-                q = self.legs.angles(pose, roots)
+            for q, sup in zip(angles, (sup_l, sup_r)):
                 excess += float(self.legs.motion_excess(q[None], dt, sup[None])[0])
                 acc = (q[2:] - 2 * q[1:-1] + q[:-2]) / dt**2
                 total += float(((acc**2 @ w) * sup[1:-1]).sum() * dt)

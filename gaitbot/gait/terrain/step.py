@@ -29,7 +29,7 @@ from ..smooth import hermite_segment, smootherstep
 from .footholds import Foothold
 from .legs import LegRange
 from .model import Terrain
-from .swing import WARPS, SwingPath, warp
+from .swing import WARPS, SwingPath, warp_table
 
 DOUBLE_SUPPORT_U = 0.25  # share of a terrain step in double support (the rear foot lifts off here)
 TERRAIN_STEP_TIME = 1.5  # a terrain step takes this many flat steps' time: higher lifts at the same joint speeds
@@ -150,7 +150,11 @@ class TerrainStepSegment:
         """Time at swing progress s in [0, 1] (lift-off to heel strike)."""
         return self.time(self.u_ds + np.asarray(s, dtype=float) * (1.0 - self.u_ds))
 
-    def feasible_warp(self, pelvis, legs: LegRange, s_to: float = 1.0, samples: int = 41):
+    def swing_frames(self) -> int:
+        """Frames from lift-off to the heel strike (a dense check of the swing samples every one)."""
+        return int(np.ceil(self.n_frames * (1.0 - self.u_ds))) + 1
+
+    def feasible_warp(self, pelvis, legs: LegRange, s_to: float = 1.0, samples: int = 31):
         """The swing timing (``swing.WARPS``, nearest the identity first) that keeps the swing leg in its
         ranges, and its speed and acceleration limits (``LegRange.motion_excess``), from lift-off to swing
         progress ``s_to`` for the pelvis path ``pelvis(t)``, and 0; or, if none
@@ -159,12 +163,12 @@ class TerrainStepSegment:
         ankle keeps its range by construction and is not checked."""
         s = np.linspace(0.0, s_to, samples)
         roots = pelvis(self.swing_time(s))
-        sigma = np.stack([warp(s, *w) for w in WARPS])
+        sigma = warp_table(s_to, samples)
         poses, _ = self.swing.fitted(sigma, np.broadcast_to(roots, (len(WARPS), samples, 2)))
-        flat_roots = np.tile(roots, (len(WARPS), 1))
-        excess = legs.excess(poses.reshape(-1, 3), flat_roots, False).reshape(len(WARPS), samples).sum(axis=1)
-        q = legs.angles(poses.reshape(-1, 3), flat_roots).reshape(len(WARPS), samples, 3)
-        excess += legs.motion_excess(q, s_to * self.duration * (1.0 - self.u_ds) / (samples - 1))
+        excess, q = legs.check(poses.reshape(-1, 3), np.tile(roots, (len(WARPS), 1)), False)
+        excess = excess.reshape(len(WARPS), samples).sum(axis=1)
+        excess += legs.motion_excess(q.reshape(len(WARPS), samples, 3),
+                                     s_to * self.duration * (1.0 - self.u_ds) / (samples - 1))
         best = int(np.argmax(excess <= 0.0)) if (excess <= 0.0).any() else int(np.argmin(excess))
         return WARPS[best], float(excess[best])
 

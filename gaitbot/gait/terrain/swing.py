@@ -32,6 +32,7 @@ lift) keeps the tipped sole clear. The run chooses the warp and the pelvis with 
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import lru_cache
 
 import numpy as np
 
@@ -50,7 +51,7 @@ AIM = 1.02  # aim this much above the clearance (frames fall between the samples
 SAMPLES = 801
 ANKLE_SPARE_RAD = np.radians(1.0)  # the swing ankle keeps this far from its limits
 ANKLE_SOFT_RAD = np.radians(10.0)  # its saturation starts this far inside the range
-_C = (0.0, 1 / 6, 1 / 3, 1 / 2, 2 / 3, 5 / 6, 1.0)
+_C = (0.0, 1 / 3, 2 / 3, 1.0)
 WARPS = tuple(sorted(((a, b) for a in _C for b in _C if a <= b),
                      key=lambda w: abs(w[0] - 1 / 3) + abs(w[1] - 2 / 3)))  # nearest the identity first
 IDENTITY = (1 / 3, 2 / 3)
@@ -60,6 +61,15 @@ def warp(s, c1: float, c2: float):
     """sigma(s): the cubic Bezier with Bernstein coefficients (0, c1, c2, 1) on s in [0, 1]."""
     s = np.clip(np.asarray(s, dtype=float), 0.0, 1.0)
     return 3 * c1 * s * (1 - s) ** 2 + 3 * c2 * s * s * (1 - s) + s**3
+
+
+@lru_cache(maxsize=16)
+def warp_table(s_to: float, samples: int) -> np.ndarray:
+    """sigma for every one of WARPS (rows) at ``samples`` swing time shares from 0 to s_to (read-only)."""
+    s = np.linspace(0.0, s_to, samples)
+    table = np.stack([warp(s, *w) for w in WARPS])
+    table.setflags(write=False)
+    return table
 
 
 def smooth_clamp(x, lo: float, hi: float, soft: float = ANKLE_SOFT_RAD):
@@ -88,6 +98,7 @@ class SwingPath:
         self.warp = IDENTITY
         self.extra = 0.0
         self._pelvis: Callable | None = None
+        self._cache: dict = {}
         self.lift = 0.0
         sigma = np.linspace(0.0, 1.0, SAMPLES)
         self.lift = self._least_lift(sigma, self.path(sigma, lift=False))
@@ -144,13 +155,11 @@ class SwingPath:
         w, n = sigma.shape
         flat_sigma = sigma.ravel()
         roots = np.asarray(roots, dtype=float).reshape(w * n, 2)
-        base = self.path(flat_sigma)
+        base, fade, shape = self._along(sigma)
         pose = base.copy()
-        fade = plateau(flat_sigma, TIP_RISE)
-        shape = plateau(flat_sigma, LIFT_RISE)
         usable = (shape > 1e-9).reshape(w, n)
         lift = np.zeros(w) if extra is None else np.broadcast_to(np.asarray(extra, dtype=float), (w,))
-        for _ in range(1 if extra is not None else 3):  # the tip moves with the lift a little: settle it
+        for round_ in range(1 if extra is not None else 3):  # the tip moves with the lift a little: settle it
             pose[:, 1] = base[:, 1] + np.repeat(lift, n) * shape
             rel = pose[:, :2] - roots
             d = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-12)
@@ -158,8 +167,8 @@ class SwingPath:
             shank = q[:, 0] - q[:, 1]
             tipped = shank + smooth_clamp(base[:, 2] - shank, self.ankle_lo, self.ankle_hi)
             pose[:, 2] = base[:, 2] + fade * (tipped - base[:, 2])
-            if extra is not None:
-                break
+            if extra is not None or (round_ == 0 and np.abs(pose[:, 2] - base[:, 2]).max() < 1e-12):
+                break  # given the extra lift, or no tipping needed: no extra lift either
             probe = pose.copy()
             probe[:, 1] = base[:, 1]
             ratio = np.where(usable, (self._need(flat_sigma, probe) / np.where(shape > 1e-9, shape, 1.0)).reshape(w, n),
@@ -167,6 +176,18 @@ class SwingPath:
             lift = np.maximum(ratio.max(axis=1), 0.0)
         pose[:, 1] = base[:, 1] + np.repeat(lift, n) * shape
         return pose.reshape(w, n, 3), lift
+
+    def _along(self, sigma):
+        """The level-sole path, the tip's fade and the lift's shape at sigma (flattened); cached for the
+        read-only tables the run asks about again and again (``warp_table``)."""
+        key = id(sigma) if not sigma.flags.writeable else None
+        if key is not None and key in self._cache:
+            return self._cache[key]
+        flat = sigma.ravel()
+        out = (self.path(flat), plateau(flat, TIP_RISE), plateau(flat, LIFT_RISE))
+        if key is not None:
+            self._cache[key] = out
+        return out
 
     def finalize(self, warp_coeffs, pelvis_at: Callable) -> None:
         """Fix the timing and the pelvis (``pelvis_at(s)`` -> hip positions at swing time shares s) and find

@@ -24,6 +24,7 @@ from ..contact import grounded_ankle
 from ..geometry import LegGeometry
 from ..segments import CrouchSegment, GaitContext, GaitGenerationError, SettleSegment, StepSegment, WalkState
 from ..trajectory import HeelStrike, Trajectory
+from .envelope import StepEnvelope
 from .footholds import Foothold, FootholdLimits, plan_footholds
 from .legs import LegRange
 from .model import Terrain
@@ -38,17 +39,15 @@ _H = 1e-6
 class TerrainSettings:
     """How to walk a terrain. Lengths in metres, angles in radians.
 
-    weights: the search cost's weights of hip, knee and ankle (seed 003: by default the joints'
-    ranges normalised to the largest). joint_lo/joint_hi: the leg's joint limits (hip, knee,
-    ankle), or None for no limits besides reach; joint_speed/joint_accel likewise for the joints'
-    speed and acceleration limits.
+    envelope: what one step can do between surfaces (envelope.py). weights: the search cost's
+    weights of hip, knee and ankle (seed 003: by default the joints' ranges normalised to the
+    largest). joint_lo/joint_hi: the leg's joint limits (hip, knee, ankle), or None for no limits
+    besides reach; joint_speed/joint_accel likewise for the joints' speed and acceleration limits.
     """
 
+    envelope: StepEnvelope
     margin: float = 0.01
     clearance: float = 0.012
-    max_step: float = 0.165
-    max_rise: float = 0.055
-    max_travel: float = 0.22
     weights: tuple[float, float, float] = (1.0, 1.0, 1.0)
     joint_lo: tuple[float, float, float] | None = None
     joint_hi: tuple[float, float, float] | None = None
@@ -140,8 +139,7 @@ class TerrainWalk:
 
 
 def terrain_limits(ctx: GaitContext, settings: TerrainSettings, flat_max_step: float) -> FootholdLimits:
-    return FootholdLimits(ctx.geometry.foot, settings.margin, min(flat_max_step, settings.max_step),
-                          settings.max_step, settings.max_rise, settings.max_travel)
+    return FootholdLimits(ctx.geometry.foot, settings.margin, flat_max_step, settings.envelope)
 
 
 def plan_terrain_walk(ctx: GaitContext, terrain: Terrain, start: float, end: float, settings: TerrainSettings,
