@@ -7,7 +7,7 @@ flows. Errors for people are raised as ``UsageError`` (one line, exit status 2).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -241,24 +241,49 @@ def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:
     return source, walker, trajectory_of(walker)
 
 
+def terrain_envelope(source: GaitSource, course):
+    """The robot's step envelope (its config's [terrain], else the unmeasured default), tightened by the
+    course's own max_rise_m / max_step_m; a course asking for more than the robot can do is refused."""
+    from gaitbot.gait.terrain.envelope import StepEnvelope
+
+    g = source.geometry
+    reach = source.robot.terrain if source.robot is not None else None
+    who = source.robot.name if source.robot is not None else "this leg"
+    if reach is not None:
+        env = StepEnvelope.for_foot(g.foot, reach.max_rise_m, reach.max_drop_m, reach.max_gap_m, who)
+    else:
+        env = StepEnvelope.default(g.foot, g.leg_length, f"{who}, not measured")
+    if course.max_rise_m is not None:
+        if course.max_rise_m > max(env.max_rise, env.max_drop) + 1e-12:
+            raise UsageError(f"{course.path}: course.max_rise_m: {course.max_rise_m:g} m is more than {who} can step "
+                             f"(max rise {env.max_rise:.3f} m, drop {env.max_drop:.3f} m)")
+        env = replace(env, max_rise=min(env.max_rise, course.max_rise_m), max_drop=min(env.max_drop, course.max_rise_m))
+    if course.max_step_m is not None:
+        if course.max_step_m > env.longest + 1e-12:
+            raise UsageError(f"{course.path}: course.max_step_m: {course.max_step_m:g} m is longer than {who} can step "
+                             f"between surfaces (max {env.longest:.3f} m)")
+        env = replace(env, max_gap=max(0.0, course.max_step_m - env.reference_step))
+    return env
+
+
 def terrain_settings(source: GaitSource, course, clearance_override: float | None = None):
-    """How to walk a course: the file's values, else the robot's (clearance, joint ranges), else defaults
-    in leg lengths (longest step onto another surface 0.75, rise 0.25; seed 000 Table 3's reach)."""
+    """How to walk a course: the file's values, else the robot's (clearance, joint ranges and limits, step
+    envelope)."""
     from gaitbot.gait.terrain.walk import TerrainSettings, default_weights
 
-    leg = source.geometry.leg_length
-    lo = hi = None
+    lo = hi = speed = accel = None
     if source.robot is not None:
-        lo = tuple(math.radians(j.min_deg) for j in source.robot.joints[:3])
-        hi = tuple(math.radians(j.max_deg) for j in source.robot.joints[:3])
+        pairs = list(zip(source.robot.joints[:3], source.robot.joints[3:6]))  # (left, right) hip, knee, ankle
+        lo = tuple(math.radians(max(a.min_deg, b.min_deg)) for a, b in pairs)
+        hi = tuple(math.radians(min(a.max_deg, b.max_deg)) for a, b in pairs)
+        speed = tuple(math.radians(min(a.max_velocity_dps, b.max_velocity_dps)) for a, b in pairs)
+        accel = tuple(math.radians(min(a.max_acceleration_dps2, b.max_acceleration_dps2)) for a, b in pairs)
     clearance = course.clearance_m if course.clearance_m is not None else source.settings.clearance
     if clearance_override is not None:
         clearance = clearance_override
-    max_step = course.max_step_m if course.max_step_m is not None else 0.75 * leg
-    return TerrainSettings(margin=course.margin_m, clearance=clearance, max_step=max_step,
-                           max_rise=course.max_rise_m if course.max_rise_m is not None else 0.25 * leg,
-                           max_travel=max_step, weights=course.weights or default_weights(lo, hi),
-                           joint_lo=lo, joint_hi=hi)
+    return TerrainSettings(envelope=terrain_envelope(source, course), margin=course.margin_m, clearance=clearance,
+                           weights=course.weights or default_weights(lo, hi), joint_lo=lo, joint_hi=hi,
+                           joint_speed=speed, joint_accel=accel)
 
 
 def build_terrain_walk(args):

@@ -11,7 +11,6 @@ import pytest
 from gaitbot.check import check_trajectory
 from gaitbot.cli import main
 from gaitbot.gait.terrain.model import Terrain, Tread
-from gaitbot.gait.terrain.search import brute_force, two_level_search
 from gaitbot.gait.terrain.walk import plan_terrain_walk
 from gaitbot.robot.config import default_config_path, load_robot_config
 from gaitbot.session import GaitSource, terrain_settings
@@ -152,10 +151,9 @@ def test_grid_search_beats_the_middle_and_nears_brute_force(stairs):
     assert reports and all(r.full_grid == 625 for r in reports)
     assert all(r.cost <= r.centre_cost for r in reports)
     assert any(r.cost < 0.9 * r.centre_cost or not np.isfinite(r.centre_cost) for r in reports)
-    inputs = [ci for run in walk.runs for ci in run.cost_inputs]
-    for region, cost, reachable in inputs[:3]:
-        fast = two_level_search(region, cost, reachable)
-        full = brute_force(region, cost, reachable, n=25)
+    for problem in walk.search_problems[:3]:
+        fast = problem.search()
+        full = problem.brute_force(25)
         assert fast.cost <= 1.05 * full.cost
         assert fast.evaluated <= 50 < full.evaluated + full.pruned
 
@@ -177,6 +175,6 @@ def test_cli_unwalkable_obstacle_exit_2(tmp_path, capsys):
                     "height_m = 0.15\n")
     assert main(["plan", "--terrain", str(wall)]) == 2
     err = capsys.readouterr().err
-    assert str(wall) in err and "cannot walk past x = 0.3" in err and "stands 0.150 m above" in err
+    assert f"{wall}: tread 1: stands 0.15 m above its neighbours" in err and "max 0.0425 m for xl430-biped" in err
     with pytest.raises(SystemExit):
         main(["plan", "--terrain", str(wall), "--steps", "0.1"])

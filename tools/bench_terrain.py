@@ -22,7 +22,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from gaitbot.gait.terrain.footholds import plan_footholds  # noqa: E402
 from gaitbot.gait.terrain.model import Terrain, Tread  # noqa: E402
-from gaitbot.gait.terrain.search import brute_force, two_level_search  # noqa: E402
 from gaitbot.gait.terrain.walk import plan_terrain_walk, terrain_limits  # noqa: E402
 from gaitbot.gait.walker import make_context  # noqa: E402
 from gaitbot.robot.config import default_config_path, load_robot_config  # noqa: E402
@@ -69,13 +68,12 @@ def main() -> int:
     print(f"grid search: {len(reports)} MDS points, {sum(r.evaluated for r in reports)} cells scored + "
           f"{sum(r.pruned for r in reports)} skipped as unreachable, against {sum(r.full_grid for r in reports)} "
           f"for full 625-cell searches")
-    inputs = [ci for run in walk.runs for ci in run.cost_inputs]
-    for i, (region, cost, reachable) in enumerate(inputs[:4], start=1):
+    for i, problem in enumerate(walk.search_problems[:4], start=1):
         t0 = time.perf_counter()
-        fast = two_level_search(region, cost, reachable)
+        fast = problem.search()
         t_fast = time.perf_counter() - t0
         t0 = time.perf_counter()
-        full = brute_force(region, cost, reachable, n=25)
+        full = problem.brute_force(25)
         t_full = time.perf_counter() - t0
         centre = f"{fast.centre_cost:.4g}" if np.isfinite(fast.centre_cost) else "unreachable"
         print(f"MDS {i}: two-level cost {fast.cost:.4g} ({fast.evaluated} scored, {t_fast * 1000:.1f} ms), "

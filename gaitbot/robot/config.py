@@ -87,6 +87,16 @@ class GaitSettings:
 
 
 @dataclass(frozen=True)
+class TerrainReach:
+    """The optional ``[terrain]`` table: what one step can do between surfaces (metres), as measured by
+    tools/terrain_envelope.py: highest rise, deepest drop, widest gap stepped over on the level."""
+
+    max_rise_m: float
+    max_drop_m: float
+    max_gap_m: float
+
+
+@dataclass(frozen=True)
 class BusSettings:
     """The serial bus. ``protocol`` is the Dynamixel protocol version; Feetech buses always get 1.0,
     the one (Dynamixel-1.0-shaped) protocol Feetech servos speak (servo_models lists them as (1.0,))."""
@@ -162,6 +172,7 @@ class RobotConfig:
     joints: tuple[JointConfig, ...]
     mass: MassSettings = MassSettings()
     servo: ServoSettings = ServoSettings()
+    terrain: TerrainReach | None = None
 
     @property
     def walking_joints(self) -> tuple[JointConfig, ...]:
@@ -281,9 +292,10 @@ def load_robot_config(path: str | Path, *, extra_checks: Iterable[ConfigCheck] =
     return config
 
 
-_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo")
+_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain")
 _MASS_KEYS = ("torso_kg", "thigh_kg", "shank_kg", "foot_kg")
 _SERVO_KEYS = ("stall_torque_nm", "no_load_speed_rpm", "full_torque_error_deg")
+_TERRAIN_KEYS = ("max_rise_m", "max_drop_m", "max_gap_m")
 _ROBOT_KEYS = ("name",)
 _GEOMETRY_KEYS = ("thigh_m", "shank_m", "foot_m", "hip_width_m", "ankle_height_m", "heel_back_m")
 _GAIT_KEYS = ("cycle_s", "max_step_m", "clearance_m", "rate_hz")
@@ -367,8 +379,12 @@ class _Reader:
         mass = self.mass(self.optional_table(data, "mass", _MASS_KEYS))
         servo = self.servo(self.optional_table(data, "servo", _SERVO_KEYS))
         self.gains_settable(joints, servo)
+        terrain = None
+        if "terrain" in data:
+            t = self.table(data, "terrain", "terrain", _TERRAIN_KEYS)
+            terrain = TerrainReach(*(self.number(t, key, "terrain", non_negative=True) for key in _TERRAIN_KEYS))
         return RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
-                           mass=mass, servo=servo)
+                           mass=mass, servo=servo, terrain=terrain)
 
     def optional_table(self, data: dict, key: str, allowed: tuple[str, ...]) -> dict:
         """An optional section: {} when absent, otherwise checked like a required one."""

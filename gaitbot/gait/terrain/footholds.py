@@ -1,15 +1,19 @@
 """Foothold planner: where each heel goes, every foot fully on one surface with a margin.
 
 A foothold is a heel x. The foot covers [heel, heel + foot]; it must lie on one surface with
-``margin`` to spare at both ends. A step (heel strike to heel strike) is at most ``flat_max_step``
-when both footholds are on the same surface (the flat walker takes it, within the Boulic model's
-range) and at most ``terrain_max_step`` when it goes to another surface; the rise between two
-footholds, and anything standing between them above the higher one, is at most ``max_rise``.
+``margin`` to spare at both ends. Steps where the rear, stance and target footholds share one
+surface are the flat walker's, at most ``flat_max_step`` long. Every other step, and the swing that
+makes it (lift-off to landing), stays within the leg's step envelope (envelope.py): no longer than
+``step_limit`` of its rise, and nothing between standing higher above the higher end than the
+largest rise. A zero step (the trailing foot closing beside the leading one) is allowed, so steep
+or short treads are taken one at a time (step-to).
 
-Among the feasible plans it takes the fewest steps, and among those the most even (dynamic
-programming on a 1 mm grid of heel positions: cost 1 per step plus a small penalty for
-straying from a preferred step length). A course that cannot be walked raises CourseError
-saying where and why.
+Among the feasible plans it takes the fewest steps, and among those the most even: dynamic
+programming over (rear heel, stance heel) on candidate heel positions (a GRID_M lattice plus both
+ends of every surface's admissible stretch, so a tread barely longer than a foot is never missed),
+cost 1 per step plus a small penalty for straying from the flat walker's preferred step. A course
+that cannot be walked raises CourseError saying where and why (course_problems names the first
+tread the envelope rules out before any planning).
 """
 
 from __future__ import annotations
@@ -18,10 +22,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import Surface, Terrain
+from .envelope import StepEnvelope, course_problems
+from .model import Terrain
 
 GRID_M = 5e-3
-PREFERRED_SHARE = 0.85  # preferred step: this share of the longest allowed
+PREFERRED_SHARE = 0.85  # preferred step: this share of the flat walker's longest
 EVENNESS = 0.3  # weight of the squared relative deviation from the preferred step
 
 
@@ -40,10 +45,8 @@ class Foothold:
 class FootholdLimits:
     foot: float  # heel to toe, metres
     margin: float
-    flat_max_step: float
-    terrain_max_step: float
-    max_rise: float
-    max_travel: float  # longest swing of one foot, lift-off to landing (heel to heel)
+    flat_max_step: float  # a step with all three footholds on one surface (the flat walker's)
+    envelope: StepEnvelope  # every other step
 
 
 def admissible(terrain: Terrain, heel_x, limits: FootholdLimits) -> np.ndarray:
@@ -57,114 +60,103 @@ def admissible(terrain: Terrain, heel_x, limits: FootholdLimits) -> np.ndarray:
     return (heel_x >= starts + limits.margin - tol) & (heel_x + limits.foot + limits.margin <= ends + tol)
 
 
-def _pair_tables(terrain: Terrain, limits: FootholdLimits):
-    """For each pair of surfaces (i <= j): the rise, the obstacle height between, and whether it is allowed."""
-    s = terrain.surfaces
-    h = np.array([p.height for p in s])
-    n = len(s)
-    rise = np.abs(h[None, :] - h[:, None])
-    obstacle = np.zeros((n, n))
+def candidates(terrain: Terrain, start: float, stop: float, limits: FootholdLimits) -> np.ndarray:
+    """Admissible heel positions from ``start`` to ``stop``: a GRID_M lattice and both ends of every
+    surface's admissible stretch."""
+    xs = [start + GRID_M * np.arange(int(np.ceil((stop - start) / GRID_M)) + 1)]
+    for s in terrain.surfaces:
+        lo, hi = s.start + limits.margin, s.end - limits.margin - limits.foot
+        xs.append(np.array([v for v in (lo, hi) if np.isfinite(v) and start <= v <= stop]))
+    xs = np.unique(np.round(np.concatenate(xs), 9))
+    return xs[admissible(terrain, xs, limits)]
+
+
+def _obstacles(terrain: Terrain) -> np.ndarray:
+    """obstacle[i, j]: how far the highest surface strictly between surfaces i < j stands above both."""
+    h = np.array([p.height for p in terrain.surfaces])
+    n = len(h)
+    out = np.zeros((n, n))
     for i in range(n):
         for j in range(i + 2, n):
-            obstacle[i, j] = max(0.0, h[i + 1:j].max() - max(h[i], h[j]))
-    ok = (rise <= limits.max_rise + 1e-12) & (obstacle <= limits.max_rise + 1e-12)
-    return rise, obstacle, ok
+            out[i, j] = out[j, i] = max(0.0, h[i + 1:j].max() - max(h[i], h[j]))
+    return out
 
 
 def plan_footholds(terrain: Terrain, start: float, end: float, limits: FootholdLimits) -> list[Foothold]:
     """Footholds from the first step to the last (the start, where both heels stand, excluded).
 
-    The last foothold is the first admissible heel position at or past ``end``. Dynamic
-    programming over states (rear heel, stance heel) on a GRID_M lattice: a step lands at most
-    the longest step ahead of the stance heel and at most ``max_travel`` ahead of where the
-    swinging foot lifted off. A zero step (the trailing foot closing beside the leading one) is
-    allowed, so stairs whose going exceeds half the travel are climbed one tread at a time."""
-    surfaces = terrain.surfaces
-    reach = max(limits.flat_max_step, limits.terrain_max_step)
-    n = int(np.ceil((end - start + 4 * reach + limits.foot) / GRID_M)) + 1
-    xs = start + GRID_M * np.arange(n)
-    ok_pos = admissible(terrain, xs, limits)
-    if not ok_pos[0]:
-        sf = surfaces[int(terrain.surface_index(start))]
+    The last foothold is the first admissible heel position at or past ``end``."""
+    env = limits.envelope
+    if not admissible(terrain, np.array([start]), limits)[0]:
+        sf = terrain.surfaces[int(terrain.surface_index(start))]
         raise CourseError(f"course.start_m: the feet at x = {start:g} m are not fully on one surface with the "
                           f"margin {limits.margin:g} m (on {sf.describe()}; foot {limits.foot:g} m long)")
-    beyond = np.nonzero(ok_pos & (xs >= end - 1e-9))[0]
+    problem = course_problems(terrain, start, end, limits.foot, limits.margin, env)
+    if problem:
+        raise CourseError(problem)
+    reach = max(limits.flat_max_step, env.longest)
+    xs = candidates(terrain, start, end + 2 * reach + limits.foot, limits)
+    beyond = np.nonzero(xs >= end - 1e-9)[0]
     if len(beyond) == 0:
         raise CourseError(f"course.end_m: no surface at or past x = {end:g} m holds a foot")
     target = int(beyond[0])
+    xs = xs[:target + 1]
+    n = len(xs)
     surf = terrain.surface_index(xs)
-    heights = np.array([p.height for p in surfaces])
-    _, _, pair_ok = _pair_tables(terrain, limits)
-    w = int(np.floor(reach / GRID_M + 1e-9))
-    travel_w = int(np.floor(limits.max_travel / GRID_M + 1e-9))
-    flat_w = int(np.floor(limits.flat_max_step / GRID_M + 1e-9))  # on one level the flat walker's swing is two steps
-    # cost[j, d]: best cost with the stance heel at j and the rear heel at j - d
-    cost = np.full((target + w + 2, w + 1), np.inf)
-    back = np.full((target + w + 2, w + 1), -1, dtype=int)
+    heights = np.array([p.height for p in terrain.surfaces])
+    obstacle = _obstacles(terrain)
+    limit = np.array([[env.step_limit(b - a) for b in heights] for a in heights])  # [from surface, to surface]
+    # cost[j][m]: best cost with the stance heel at j and the rear heel at j - m (m = 0: side by side)
+    window = int(max(np.searchsorted(xs, xs + 2 * reach + 1e-9) - np.arange(n))) + 1
+    cost = np.full((n, window), np.inf)
+    back = np.full((n, window), -1, dtype=int)
     cost[0, 0] = 0.0
-    d_rear = np.arange(w + 1)[:, None]  # rear offset behind the stance heel
-    ahead = np.arange(w + 1)[None, :]  # next heel ahead of the stance heel
     for j in range(target):
-        row = cost[j]
-        if not np.isfinite(row).any() or not ok_pos[j]:
-            continue
-        k = j + ahead  # (1, w+1)
-        k_ok = (k <= target)
-        kk = np.minimum(k, target)
-        rear = np.maximum(j - d_rear, 0)
-        step = ahead * GRID_M
-        same = surf[kk] == surf[j]
-        longest = np.where(same, limits.flat_max_step, limits.terrain_max_step)
-        lo1, hi1 = np.minimum(surf[j], surf[kk]), np.maximum(surf[j], surf[kk])
-        lo2, hi2 = np.minimum(surf[rear], surf[kk]), np.maximum(surf[rear], surf[kk])
-        valid = (k_ok & ok_pos[kk] & (step <= longest + 1e-9) & pair_ok[lo1, hi1] & pair_ok[lo2, hi2]
-                 & ((k - rear <= travel_w) | (same & (surf[rear] == surf[j]) & (k - rear <= 2 * flat_w)))
-                 & np.isfinite(row)[:, None] & ~((ahead == 0) & (d_rear == 0)))
-        pref = PREFERRED_SHARE * longest
-        c = row[:, None] + 1.0 + EVENNESS * np.where(ahead > 0, ((step - pref) / pref) ** 2, 0.5)
-        c = np.where(valid, c, np.inf)
-        best_d = np.argmin(c, axis=0)  # per next heel
-        best = c[best_d, np.arange(w + 1)]
-        for a in np.nonzero(np.isfinite(best))[0]:
-            knext = j + a
-            if best[a] < cost[knext, a]:
-                cost[knext, a], back[knext, a] = best[a], best_d[a]
-    final = cost[target].copy()
-    final[np.arange(w + 1) > travel_w] = np.inf  # the closing step must reach too
-    if not np.isfinite(final).any():
-        raise CourseError(_why_blocked(terrain, xs[:target + 1], ok_pos[:target + 1],
-                                       np.where(np.isfinite(cost[:target + 1]).any(axis=1), 0.0, np.inf), limits))
-    j, d = target, int(np.argmin(final))
+        for zero_only in (True, False):  # zero steps first: their states (j, j) step on from j too
+            row = cost[j].copy()
+            if not np.isfinite(row).any():
+                continue
+            m = np.arange(window)
+            rear = j - m
+            live = np.isfinite(row) & (rear >= 0)
+            k_hi = int(np.searchsorted(xs, xs[j] + reach + 1e-9))
+            ks = np.arange(j, min(k_hi, target + 1)) if not zero_only else np.array([j])
+            if len(ks) == 0 or not live.any():
+                continue
+            r = np.where(live, rear, 0)[:, None]  # (window, 1)
+            k = ks[None, :]  # (1, K)
+            step, travel = xs[k] - xs[j], xs[k] - xs[r]
+            same = (surf[r] == surf[j]) & (surf[j] == surf[k])
+            flat_ok = same & (step <= limits.flat_max_step + 1e-9) & (travel <= 2 * limits.flat_max_step + 1e-9)
+            terrain_ok = ((step <= limit[surf[j], surf[k]] + 1e-9) & (travel <= limit[surf[r], surf[k]] + 1e-9)
+                          & (obstacle[surf[j], surf[k]] <= env.max_rise + 1e-12)
+                          & (obstacle[surf[r], surf[k]] <= env.max_rise + 1e-12))
+            valid = live[:, None] & (flat_ok | (~same & terrain_ok)) & ~((k == j) & (r == j))
+            pref = PREFERRED_SHARE * limits.flat_max_step
+            c = row[:, None] + 1.0 + EVENNESS * np.where(step > 0, ((step - pref) / pref) ** 2, 0.5)
+            c = np.where(valid, c, np.inf)
+            best_m = np.argmin(c, axis=0)
+            best = c[best_m, np.arange(len(ks))]
+            for col in np.nonzero(np.isfinite(best))[0]:
+                kk = int(ks[col])
+                mm = kk - j
+                if mm < window and best[col] < cost[kk, mm]:
+                    cost[kk, mm], back[kk, mm] = best[col], best_m[col]
+    if not np.isfinite(cost[target]).any():
+        raise CourseError(_why_blocked(terrain, xs, cost))
+    j, m = target, int(np.argmin(cost[target]))
     path = [j]
     while j != 0:
-        j, d = j - d, int(back[j, d])
+        j, m = j - m, int(back[j, m])
         path.append(j)
     path.reverse()
     return [Foothold(float(xs[j]), float(heights[surf[j]]), int(surf[j])) for j in path[1:]]
 
 
-def _why_blocked(terrain: Terrain, xs, ok_pos, cost, limits: FootholdLimits) -> str:
-    surfaces = terrain.surfaces
-    reached = np.nonzero(np.isfinite(cost))[0]
+def _why_blocked(terrain: Terrain, xs, cost) -> str:
+    """Where the plan stops (course_problems found nothing: a combination of steps the planner cannot chain)."""
+    reached = np.nonzero(np.isfinite(cost).any(axis=1))[0]
     r = int(reached[-1])
-    here: Surface = surfaces[int(terrain.surface_index(xs[r]))]
-    ahead = np.nonzero(ok_pos & (np.arange(len(xs)) > r) & (terrain.surface_index(xs) != terrain.surface_index(xs[r])))[0]
-    where = f"cannot walk past x = {xs[r]:.3f} m (last reachable heel, on {here.describe()})"
-    if len(ahead) == 0:
-        return f"{where}: no surface ahead holds a foot ({limits.foot:g} m plus margins {limits.margin:g} m)"
-    a = int(ahead[0])
-    there = surfaces[int(terrain.surface_index(xs[a]))]
-    rise = there.height - here.height
-    if abs(rise) > limits.max_rise:
-        kind = "rise" if rise > 0 else "drop"
-        return (f"{where}: the next surface that holds a foot, {there.describe()}, is a {kind} of {abs(rise):.3f} m, "
-                f"more than the leg can step (max_rise_m {limits.max_rise:.3f} m)")
-    between = [s for s in surfaces if s.start >= here.end - 1e-12 and s.end <= there.start + 1e-12]
-    tall = [s for s in between if s.height - max(here.height, there.height) > limits.max_rise]
-    if tall:
-        return (f"{where}: {tall[0].describe()} stands {tall[0].height - max(here.height, there.height):.3f} m above "
-                f"its neighbours, more than the leg can step over (max_rise_m {limits.max_rise:.3f} m)")
-    gap = xs[a] - xs[r]
-    return (f"{where}: the nearest foothold beyond, on {there.describe()}, is {gap:.3f} m ahead, longer than "
-            f"the longest step {limits.terrain_max_step:.3f} m (surfaces between are too short for a "
-            f"{limits.foot:g} m foot with {limits.margin:g} m margins)")
+    here = terrain.surfaces[int(terrain.surface_index(xs[r]))]
+    return (f"cannot walk past x = {xs[r]:.3f} m (last reachable heel, on {here.describe()}): no sequence of steps "
+            f"within this leg's envelope reaches further")

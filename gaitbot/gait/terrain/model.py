@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -78,7 +79,7 @@ class Terrain:
                 raise TerrainError(f"tread[{b + 1}].start_m", f"leaves a {gap * 1000:.2g} mm gap after tread {a + 1}: "
                                    f"make them touch (start_m = {ta.end_m:g}) or leave a real gap")
 
-    @property
+    @cached_property
     def surfaces(self) -> tuple[Surface, ...]:
         pieces: list[Surface] = []
         x = -math.inf
@@ -101,19 +102,24 @@ class Terrain:
         s = self.surfaces
         return [(a.end, max(a.height, b.height)) for a, b in zip(s, s[1:])]
 
+    @cached_property
+    def _bounds(self) -> np.ndarray:
+        return np.array([p.end for p in self.surfaces[:-1]])
+
+    @cached_property
+    def _heights(self) -> np.ndarray:
+        return np.array([p.height for p in self.surfaces])
+
     def surface_index(self, x) -> np.ndarray:
         """Index into ``surfaces`` of the surface holding x (within 1e-12 m of an edge: the higher one)."""
         x = np.asarray(x, dtype=float)
-        s = self.surfaces
-        bounds = np.array([p.end for p in s[:-1]])
-        heights = np.array([p.height for p in s])
+        bounds, heights = self._bounds, self._heights
         left = np.searchsorted(bounds, x - 1e-12, side="left")
         right = np.searchsorted(bounds, x + 1e-12, side="right")
         return np.where(heights[right] > heights[left], right, left)
 
     def height_at(self, x) -> np.ndarray:
-        heights = np.array([p.height for p in self.surfaces])
-        return heights[self.surface_index(x)]
+        return self._heights[self.surface_index(x)]
 
     def max_height(self, x0: float, x1: float) -> float:
         """Highest surface over the closed interval [x0, x1]."""
