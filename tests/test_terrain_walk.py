@@ -175,6 +175,9 @@ def test_cli_unwalkable_obstacle_exit_2(tmp_path, capsys):
                     "height_m = 0.15\n")
     assert main(["plan", "--terrain", str(wall)]) == 2
     err = capsys.readouterr().err
-    assert f"{wall}: tread 1: stands 0.15 m above its neighbours" in err and "max 0.0425 m for xl430-biped" in err
+    from gaitbot.robot.config import default_config_path, load_robot_config
+
+    max_rise = load_robot_config(default_config_path()).terrain.max_rise_m  # the robot's stated envelope
+    assert f"{wall}: tread 1: stands 0.15 m above its neighbours" in err and f"max {max_rise:.4f} m for xl430-biped" in err
     with pytest.raises(SystemExit):
         main(["plan", "--terrain", str(wall), "--steps", "0.1"])
