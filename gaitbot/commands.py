@@ -70,7 +70,7 @@ def cmd_generate(args) -> int:
     _, walker, trajectory = trajectory_for_robot(args)
     trajectory.save(out)
     print(f"wrote {out}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
-          f"{len(walker.heel_strikes)} heel strikes, {trajectory.root_m[-1, 0]:.4f} m")
+          f"{len(walker.heel_strikes)} heel strikes, {trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.4f} m")
     return 0
 
 
@@ -208,7 +208,7 @@ def cmd_walk(args) -> int:
     else:
         mode = "dry run (mock bus, simulated clock: timing figures are exact by construction; --realtime paces it)"
     print(f"{config.name}: {mode}: {len(walker.planned_steps)} heel strikes, "
-          f"{trajectory.root_m[-1, 0]:.3f} m planned. {result.message()}")
+          f"{trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.3f} m planned. {result.message()}")
     if result.walk_stats is not None:
         print(result.walk_stats.summary())
     if args.record:

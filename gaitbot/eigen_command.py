@@ -179,7 +179,7 @@ def run_synth(args) -> int:
     walk.save(out)
     xs = [h.x_m for h in walk.heel_strikes]
     print(f"wrote {out}: {len(walk)} frames, {walk.t_s[-1]:.2f} s, {len(xs)} heel strikes, "
-          f"{walk.root_m[-1, 0]:.4f} m; step lengths {', '.join(f'{d:.4f}' for d in np.diff(xs))} m")
+          f"{walk.root_m[-1, 0] - walk.root_m[0, 0]:.4f} m; step lengths {', '.join(f'{d:.4f}' for d in np.diff(xs))} m")
     if pose_report is not None:
         starts = [h.t_s for h in walk.heel_strikes if h.leg == "left"][:args.cycles]
         times = ", ".join(f"{t + pose_report[0]:.3f}" for t in starts)

@@ -70,7 +70,7 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
         ax_angles.axvline(strike.t_s, color=_COLOURS[strike.leg], lw=0.5, alpha=0.4)
     ax_angles.set_ylabel("joint angle (deg, flexion +)")
     ax_angles.legend(ncol=6, fontsize=8, loc="upper center")
-    ax_angles.set_title(f"{title}  {len(t)} frames, {t[-1]:.2f} s, {trajectory.root_m[-1, 0]:.3f} m"
+    ax_angles.set_title(f"{title}  {len(t)} frames, {t[-1]:.2f} s, {trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.3f} m"
                         f"  (vertical lines: heel strikes)")
     ax_angles.grid(alpha=0.3)
 
