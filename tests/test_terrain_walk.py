@@ -124,7 +124,7 @@ def test_stairs_walk_cleanly(stairs):
     course, walk, settings = stairs
     judge(walk, settings, course.terrain.treads)
     heights = {round(s.height_m, 6) for s in walk.steps}
-    assert heights >= {0.0, 0.02, 0.04, 0.06}
+    assert heights >= {0.0} | {round(t.height_m, 6) for t in course.terrain.treads}  # every stair is stood on
     # one trajectory from flat ground up and back down to flat ground, ending where it should
     assert walk.trajectory.root_m[-1, 0] == pytest.approx(walk.steps[-1].foothold_m + GEOMETRY.heel_back, abs=1e-6)
 
