@@ -4,6 +4,7 @@
     python tools/bench.py gait            # walker: online per frame, offline frames/s, RV solve
     python tools/bench.py stream          # 60 s real-time dry run of the default robot on the mock bus
     python tools/bench.py stream --seconds 10
+    python tools/bench.py terrain         # 10 stairs planned and generated; grid search on the examples
 
 Figures are medians/percentiles of repeated measurements with time.perf_counter; nothing here
 is asserted (timed tests are flaky on shared machines).
@@ -122,7 +123,7 @@ def bench_stream(seconds: float) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("sections", nargs="*", default=["gait", "stream"], help="gait, stream")
+    parser.add_argument("sections", nargs="*", default=["gait", "stream"], help="gait, stream, terrain")
     parser.add_argument("--seconds", type=float, default=60.0, help="length of the streaming run")
     args = parser.parse_args()
     print(f"machine: {machine()}")
@@ -131,8 +132,13 @@ def main() -> None:
             bench_gait()
         elif section == "stream":
             bench_stream(args.seconds)
+        elif section == "terrain":  # tools/bench_terrain.py
+            sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+            import bench_terrain
+
+            bench_terrain.main([])
         else:
-            parser.error(f"unknown section {section!r} (gait, stream)")
+            parser.error(f"unknown section {section!r} (gait, stream, terrain)")
 
 
 if __name__ == "__main__":

@@ -39,6 +39,8 @@ HEEL_OFF_CHOICES_RAD = np.radians([0.0, -4.0, -8.0, -12.0, -16.0, -20.0, -25.0, 
 HEEL_OFF_ROOM = 0.5  # the least heel-off leaving the pelvis this share of the most room any heel-off leaves
 LANDING_SPARE_RAD = np.radians(3.0)  # the landing test keeps this far inside the joint ranges
 LANDING_MIN_KNEE_RAD = np.radians(8.0)
+TIP_LIFT_SHARE = 1.0  # a timing whose tipped sole needs more extra lift than this share of the clearance is out:
+# the tip grows with the lift (a higher foot bends the knee more), so large extra lifts are fragile
 FREE_ANKLE_RAD = (-np.radians(60.0), np.radians(60.0))  # the swing ankle's range when no joint ranges are given
 
 
@@ -164,9 +166,10 @@ class TerrainStepSegment:
         s = np.linspace(0.0, s_to, samples)
         roots = pelvis(self.swing_time(s))
         sigma = warp_table(s_to, samples)
-        poses, _ = self.swing.fitted(sigma, np.broadcast_to(roots, (len(WARPS), samples, 2)))
+        poses, extra = self.swing.fitted(sigma, np.broadcast_to(roots, (len(WARPS), samples, 2)))
         excess, q = legs.check(poses.reshape(-1, 3), np.tile(roots, (len(WARPS), 1)), False)
         excess = excess.reshape(len(WARPS), samples).sum(axis=1)
+        excess += np.maximum(extra - TIP_LIFT_SHARE * self.swing.clearance, 0.0) / self.ctx.geometry.leg_length
         excess += legs.motion_excess(q.reshape(len(WARPS), samples, 3),
                                      s_to * self.duration * (1.0 - self.u_ds) / (samples - 1))
         best = int(np.argmax(excess <= 0.0)) if (excess <= 0.0).any() else int(np.argmin(excess))
