@@ -20,6 +20,7 @@ from gaitbot.robot.config import load_robot_config
 from gaitbot.robot.gait_setup import leg_geometry, walk_settings
 from gaitbot.session import GaitSource, terrain_settings
 from gaitbot.terrain_file import Course, load_course
+from terrain_profile import height, surface_pieces
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "config" / "terrain"
@@ -65,31 +66,6 @@ def fk_feet(cfg, q, root):
     heel = ankle + g.ankle_height_m * np.column_stack([np.sin(p), -np.cos(p)])
     toe = heel + g.foot_m * np.column_stack([np.cos(p), np.sin(p)])
     return heel, toe
-
-
-def surface_pieces(treads):
-    pieces, x = [], -np.inf
-    for t in sorted(treads, key=lambda t: t.start_m):
-        if t.start_m > x + 1e-9:
-            pieces.append([x, t.start_m, 0.0])
-        pieces.append([t.start_m, t.start_m + t.length_m, t.height_m])
-        x = t.start_m + t.length_m
-    pieces.append([x, np.inf, 0.0])
-    merged = []
-    for p in pieces:
-        if merged and merged[-1][2] == p[2] and abs(merged[-1][1] - p[0]) < 1e-9:
-            merged[-1][1] = p[1]
-        else:
-            merged.append(p)
-    return merged
-
-
-def height(pieces, x):
-    """Terrain height under x (at an edge: the higher side), independent of gaitbot's Terrain."""
-    out = np.zeros_like(x)
-    for i, xi in enumerate(x):
-        out[i] = max(h for s, e, h in pieces if s - 1e-12 <= xi <= e + 1e-12)
-    return out
 
 
 def judge(rb: Robot, walk, settings, treads):

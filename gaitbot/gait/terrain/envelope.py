@@ -11,9 +11,11 @@ table:
   a foot) stepped over between two surfaces at one level.
 
 From them, the longest heel-to-heel step between two surfaces ``rise`` apart (``step_limit``):
-``reference_step + max_gap`` on the level, falling linearly to ``reference_step`` at the largest
-rise or drop, where ``reference_step`` is the shortest step from one tread to the next (a foot plus
-its margin at both ends, with the margin the envelope was measured at). The same limit holds for a
+``reference_step + max_gap`` on the level, falling to ``reference_step`` at the largest rise or
+drop as (1 - rise / largest)^2 (a long step and a large rise together ask for both the reach and
+the lift: measured, that falls faster than linearly), where ``reference_step`` is the shortest
+step from one tread to the next (a foot plus its margin at both ends, with the margin the
+envelope was measured at). The same limit holds for a
 swing from lift-off to landing, so steep steps are taken one at a time (step-to), as a small
 child climbs stairs.
 
@@ -61,7 +63,7 @@ class StepEnvelope:
         if size > top + 1e-12:
             return -1.0
         share = size / top if size > 0 else 0.0
-        return self.reference_step + self.max_gap * (1.0 - share)
+        return self.reference_step + self.max_gap * (1.0 - share) ** 2
 
     @property
     def longest(self) -> float:
