@@ -31,7 +31,6 @@ from .legs import LegRange
 from .pelvis import Knot, PelvisPath
 from .search import Region, SearchResult, brute_force, two_level_search
 from .step import TerrainStepSegment
-from .swing import warp
 
 MS_KNEE_RAD = np.radians(15.0)  # the pelvis at mid-stance is no higher than this stance knee bend allows ...
 MS_KNEE_DOWN_RAD = np.radians(8.0)  # ... or this one on a step down, where a high pelvis lets the foot behind lift
@@ -118,13 +117,10 @@ class TerrainRun:
         stance_end = last.stance_world(np.array([1.0]))[0]
         guess = Knot(float(last.time(1.0)), (0.5 * (stance_end[0] + last.landing[0]), 0.0), (0.0, 0.0), "end")
         self.knots = [start]
-        ms = []
         for k in range(len(segments)):
             after = candidates[k + 1][0] if k + 1 < len(segments) else guess
-            mds, chosen = self._mds_and_ms(k, self.knots[-1], candidates[k], after)
-            ms.append(chosen)
-            self.knots += [mds, chosen]
-        self.knots.append(self._end_knot(self.knots[-2], ms[-1]))
+            self.knots += self._mds_and_ms(k, self.knots[-1], candidates[k], after)
+        self.knots.append(self._end_knot(self.knots[-1]))
         self.path = PelvisPath(self.knots)
         for seg, w in zip(segments, self.warps):
             seg.pelvis = self.path
@@ -134,14 +130,8 @@ class TerrainRun:
         """The swing timing checked at every frame on the final path (the search samples more sparsely): the
         one chosen if it holds there, else the best at that density."""
         dense = seg.swing_frames()
-        committed = [chosen] if chosen is not None else []
-        for w in committed:
-            s = np.linspace(0.0, 1.0, dense)
-            poses, _ = seg.swing.fitted(warp(s, *w)[None], self.path(seg.swing_time(s))[None])
-            excess, q = self.swing_legs.check(poses[0], self.path(seg.swing_time(s)), False)
-            dt = seg.duration * (1.0 - seg.u_ds) / (dense - 1)
-            if excess.sum() + self.swing_legs.motion_excess(q[None], dt)[0] <= 0.0:
-                return w
+        if chosen is not None and seg.feasible_warp(self.path, self.swing_legs, samples=dense, warps=(chosen,))[1] <= 0:
+            return chosen
         return seg.feasible_warp(self.path, self.swing_legs, samples=dense)[0]
 
     # --- feet of the whole run -------------------------------------------------------------------
@@ -231,7 +221,7 @@ class TerrainRun:
                 first_error = first_error or exc
         raise first_error or GaitGenerationError(f"{self.segments[k].what}: the pelvis would have to move back")
 
-    def _end_knot(self, last_mds: Knot, last_ms: Knot) -> Knot:
+    def _end_knot(self, last_ms: Knot) -> Knot:
         """Where the run hands over at its last heel strike: between the feet, as high as the legs allow
         over the whole last segment (from the last MS on, which no MDS search covers), where the last
         swing finds a timing that keeps its leg in range."""

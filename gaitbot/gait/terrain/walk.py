@@ -204,10 +204,12 @@ def step_methods(ctx: GaitContext, terrain: Terrain, holds: list[Foothold], flat
 
     A step is the flat walker's where its rear, stance and target footholds share one level surface
     with no edge between, except a short step (a closing step, a shuffle to the front of a tread)
-    right before or after a terrain step, and the step after a terrain run that ends with the feet
-    side by side: the flat walker brings its pelvis back over the feet at a closing step and sways
-    it back a little when it starts from the feet side by side, which next to a terrain run would
-    make the pelvis turn back (a loop in its path); as part of the run it keeps moving forward."""
+    right before or after a terrain step, the step after a terrain run that ends with the feet side
+    by side, and a lone flat step between two terrain steps: the flat walker brings its pelvis back
+    over the feet at a closing step and sways it back a little when it starts from the feet side by
+    side, which next to a terrain run would make the pelvis turn back (a loop in its path), and two
+    hand-overs around one flat step leave neither side room; as part of the run it keeps moving
+    forward."""
     methods = []
     for rear, stance, target in zip(holds, holds[1:], holds[2:]):
         flat = (rear.surface == stance.surface == target.surface
@@ -224,6 +226,9 @@ def step_methods(ctx: GaitContext, terrain: Terrain, holds: list[Foothold], flat
                 methods[i] = "terrain"
     for i in range(1, last):  # the flat walker starting from feet side by side first sways back a little
         if methods[i] == "flat" and methods[i - 1] == "terrain" and abs(steps[i - 1]) < 1e-9:
+            methods[i] = "terrain"
+    for i in range(1, last):  # a lone flat step between two terrain steps: one run through it, not two hand-overs
+        if methods[i] == "flat" and methods[i - 1] == methods[i + 1] == "terrain":
             methods[i] = "terrain"
     return methods
 
