@@ -10,6 +10,7 @@ from gaitbot.gait.terrain.envelope import StepEnvelope
 from gaitbot.gait.terrain.footholds import CourseError, FootholdLimits, plan_footholds
 from gaitbot.gait.terrain.model import Terrain, Tread
 from gaitbot.terrain_file import load_course
+from terrain_profile import surface_pieces
 
 EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "config" / "terrain").glob("*.toml"))
 FOOT, MARGIN, FLAT = 0.12, 0.01, 0.10
@@ -19,29 +20,11 @@ LIMITS = FootholdLimits(FOOT, MARGIN, FLAT, StepEnvelope.for_foot(FOOT, RISE, DR
 
 def step_limit(rise):
     """Independent restatement of the envelope: FOOT + 2 cm + GAP on the level, down to FOOT + 2 cm at the
-    largest rise or drop, nothing beyond."""
+    largest rise or drop along (1 - rise / largest)^2, nothing beyond."""
     top = RISE if rise > 0 else DROP
     if abs(rise) > top + 1e-12:
         return -1.0
-    return FOOT + 0.02 + GAP * (1 - abs(rise) / top)
-
-
-def surfaces_from_treads(treads):
-    """Independent profile: (start, end, height) pieces including the ground at 0, equal neighbours merged."""
-    pieces, x = [], -np.inf
-    for t in sorted(treads, key=lambda t: t.start_m):
-        if t.start_m > x + 1e-9:
-            pieces.append([x, t.start_m, 0.0])
-        pieces.append([t.start_m, t.start_m + t.length_m, t.height_m])
-        x = t.start_m + t.length_m
-    pieces.append([x, np.inf, 0.0])
-    merged = []
-    for p in pieces:
-        if merged and merged[-1][2] == p[2] and abs(merged[-1][1] - p[0]) < 1e-9:
-            merged[-1][1] = p[1]
-        else:
-            merged.append(p)
-    return merged
+    return FOOT + 0.02 + GAP * (1 - abs(rise) / top) ** 2
 
 
 def holding_piece(pieces, heel, foot, margin):
@@ -53,7 +36,7 @@ def holding_piece(pieces, heel, foot, margin):
 
 
 def check_plan(treads, start, end, holds):
-    pieces = surfaces_from_treads(treads)
+    pieces = surface_pieces(treads)
     xs = [start, start] + [h.heel_x for h in holds]
     idx = []
     for x in xs:

@@ -5,6 +5,7 @@
     python tools/bench.py stream          # 60 s real-time dry run of the default robot on the mock bus
     python tools/bench.py stream --seconds 10
     python tools/bench.py sim             # real-time factor of `gaitbot walk --sim` (the sim extra)
+    python tools/bench.py terrain         # 10 stairs planned and generated; grid search on the examples
 
 Figures are medians/percentiles of repeated measurements with time.perf_counter; nothing here
 is asserted (timed tests are flaky on shared machines).
@@ -159,7 +160,7 @@ def bench_sim(distance_m: float = 1.0, repeats: int = 3) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("sections", nargs="*", default=["gait", "stream"], help="gait, stream, sim")
+    parser.add_argument("sections", nargs="*", default=["gait", "stream"], help="gait, stream, sim, terrain")
     parser.add_argument("--seconds", type=float, default=60.0, help="length of the streaming run")
     args = parser.parse_args()
     print(f"machine: {machine()}")
@@ -170,8 +171,13 @@ def main() -> None:
             bench_stream(args.seconds)
         elif section == "sim":
             bench_sim()
+        elif section == "terrain":  # tools/bench_terrain.py
+            sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+            import bench_terrain
+
+            bench_terrain.main([])
         else:
-            parser.error(f"unknown section {section!r} (gait, stream, sim)")
+            parser.error(f"unknown section {section!r} (gait, stream, sim, terrain)")
 
 
 if __name__ == "__main__":

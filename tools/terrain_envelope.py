@@ -10,8 +10,8 @@ limits (positions, velocities, accelerations) on every course of its family:
 - rise r: three stairs up of rise r, then a landing, at goings from the shortest (a foot plus its
   margins) to twice that, and a single kerb of r;
 - drop r: the same going down (from a landing into a pit), and a single drop;
-- gap w: a ditch w wide (and 5 cm deep) between level ground, and a gap w * (1 - 1/2) before a
-  step of half the largest rise and drop (the envelope is linear in between, envelope.py).
+- gap w: a ditch w wide (and 5 cm deep) between level ground, and gaps w (1 - f)^2 before a step
+  of f times the largest rise and drop, f = 1/2 and 1/5 (the envelope's curve, envelope.py).
 
 ``--measure`` bisects each value on a 2.5 mm grid, with the others at 0, then states the envelope
 one grid step below what it found (a margin for courses between the measured ones) and verifies
@@ -97,7 +97,8 @@ def families(robot: Robot, env: StepEnvelope) -> dict[str, list[Course]]:
     return {
         "rise": [stairs(env.max_rise, g) for g in goings] + [kerb(env.max_rise)],
         "drop": [stairs(-env.max_drop, g) for g in goings] + [kerb(-env.max_drop)],
-        "gap": [gap(env.max_gap), gap(env.max_gap / 2, env.max_rise / 2), gap(env.max_gap / 2, -env.max_drop / 2)],
+        "gap": [gap(env.max_gap), gap(env.max_gap / 4, env.max_rise / 2), gap(env.max_gap / 4, -env.max_drop / 2),
+                gap(0.64 * env.max_gap, env.max_rise / 5), gap(0.64 * env.max_gap, -env.max_drop / 5)],
     }
 
 

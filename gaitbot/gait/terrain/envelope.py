@@ -11,9 +11,11 @@ table:
   a foot) stepped over between two surfaces at one level.
 
 From them, the longest heel-to-heel step between two surfaces ``rise`` apart (``step_limit``):
-``reference_step + max_gap`` on the level, falling linearly to ``reference_step`` at the largest
-rise or drop, where ``reference_step`` is the shortest step from one tread to the next (a foot plus
-its margin at both ends, with the margin the envelope was measured at). The same limit holds for a
+``reference_step + max_gap`` on the level, falling to ``reference_step`` at the largest rise or
+drop as (1 - rise / largest)^2 (a long step and a large rise together ask for both the reach and
+the lift: measured, that falls faster than linearly), where ``reference_step`` is the shortest
+step from one tread to the next (a foot plus its margin at both ends, with the margin the
+envelope was measured at). The same limit holds for a
 swing from lift-off to landing, so steep steps are taken one at a time (step-to), as a small
 child climbs stairs.
 
@@ -61,7 +63,7 @@ class StepEnvelope:
         if size > top + 1e-12:
             return -1.0
         share = size / top if size > 0 else 0.0
-        return self.reference_step + self.max_gap * (1.0 - share)
+        return self.reference_step + self.max_gap * (1.0 - share) ** 2
 
     @property
     def longest(self) -> float:
@@ -89,13 +91,16 @@ def course_problems(terrain: Terrain, start: float, end: float, foot: float, mar
             break
         where = _name(there, surfaces, b)
         rise = there.height - here.height
+        between = surfaces[a + 1:b]
+        short = [s for s in between if s.tread]
+        too_short = (f"; {_names(short)} before it {'is' if len(short) == 1 else 'are'} too short to stand on "
+                     f"(a foot needs {foot + 2 * margin:.4g} m)") if short else ""
         if rise > envelope.max_rise + 1e-12:
             return (f"{where}: rise {rise:.4g} m exceeds what this leg can step (max {envelope.max_rise:.4g} m "
-                    f"for {envelope.who})")
+                    f"for {envelope.who}){too_short}")
         if -rise > envelope.max_drop + 1e-12:
             return (f"{where}: drop {-rise:.4g} m exceeds what this leg can step down (max {envelope.max_drop:.4g} m "
-                    f"for {envelope.who})")
-        between = surfaces[a + 1:b]
+                    f"for {envelope.who}){too_short}")
         if between:
             top = max(s.height for s in between) - max(here.height, there.height)
             if top > envelope.max_rise + 1e-12:
@@ -109,8 +114,18 @@ def course_problems(terrain: Terrain, start: float, end: float, foot: float, mar
             what = "a gap" if gap > 1e-9 else "a step"
             return (f"{where}: {what} of {gap:.4g} m to step over at a rise of {rise:+.4g} m needs a step of "
                     f"{needed:.4g} m (heel to heel, margins {margin:g} m), longer than the {limit:.4g} m this leg "
-                    f"can step there (widest gap on the level {envelope.max_gap:.4g} m for {envelope.who})")
+                    f"can step there (widest gap on the level {envelope.max_gap:.4g} m for {envelope.who})"
+                    f"{too_short}")
     return None
+
+
+def _names(pieces) -> str:
+    numbers = [p.tread for p in pieces]
+    if len(numbers) == 1:
+        return f"tread {numbers[0]}"
+    if numbers == list(range(numbers[0], numbers[-1] + 1)):
+        return f"treads {numbers[0]} to {numbers[-1]}"
+    return "treads " + ", ".join(str(n) for n in numbers)
 
 
 def _name(surface: Surface, surfaces, index: int) -> str:

@@ -6,12 +6,16 @@ surface are the flat walker's, at most ``flat_max_step`` long. Every other step,
 makes it (lift-off to landing), stays within the leg's step envelope (envelope.py): no longer than
 ``step_limit`` of its rise, and nothing between standing higher above the higher end than the
 largest rise. A zero step (the trailing foot closing beside the leading one) is allowed, so steep
-or short treads are taken one at a time (step-to).
+or short treads are taken one at a time (step-to); a shuffle (a very short step, under
+SHUFFLE_SHARE of a flat step) is not, as a step off the flat or right before one: it would swing
+the trailing foot further than a closing step does, for nothing.
 
 Among the feasible plans it takes the fewest steps, and among those the most even: dynamic
 programming over (rear heel, stance heel) on candidate heel positions (a GRID_M lattice plus both
 ends of every surface's admissible stretch, so a tread barely longer than a foot is never missed),
-cost 1 per step plus a small penalty for straying from the flat walker's preferred step. A course
+cost 1 per step plus a small penalty for straying from the flat walker's preferred step (a larger
+one for a step off the flat longer than that: the edge of the envelope is for ditches and stairs
+that need it, not for saving a step on easy ground). A course
 that cannot be walked raises CourseError saying where and why (course_problems names the first
 tread the envelope rules out before any planning).
 """
@@ -28,6 +32,8 @@ from .model import Terrain
 GRID_M = 5e-3
 PREFERRED_SHARE = 0.85  # preferred step: this share of the flat walker's longest
 EVENNESS = 0.3  # weight of the squared relative deviation from the preferred step
+LONG_TERRAIN_STEP = 1.0  # ... for a step off the flat longer than preferred: taken only where it saves a step and more
+SHUFFLE_SHARE = 0.3  # a step off the flat is a closing step (0) or at least this share of the flat walker's longest
 
 
 class CourseError(ValueError):
@@ -131,9 +137,14 @@ def plan_footholds(terrain: Terrain, start: float, end: float, limits: FootholdL
             terrain_ok = ((step <= limit[surf[j], surf[k]] + 1e-9) & (travel <= limit[surf[r], surf[k]] + 1e-9)
                           & (obstacle[surf[j], surf[k]] <= env.max_rise + 1e-12)
                           & (obstacle[surf[r], surf[k]] <= env.max_rise + 1e-12))
-            valid = live[:, None] & (flat_ok | (~same & terrain_ok)) & ~((k == j) & (r == j))
+            short = SHUFFLE_SHARE * limits.flat_max_step
+            shuffle = (step > 1e-9) & (step < short)
+            came_shuffling = (xs[j] - xs[r] > 1e-9) & (xs[j] - xs[r] < short)  # (window, 1)
+            valid = (live[:, None] & (flat_ok | (~same & terrain_ok & ~shuffle & ~came_shuffling))
+                     & ~((k == j) & (r == j)))
             pref = PREFERRED_SHARE * limits.flat_max_step
-            c = row[:, None] + 1.0 + EVENNESS * np.where(step > 0, ((step - pref) / pref) ** 2, 0.5)
+            weight = np.where(~same & (step > pref), LONG_TERRAIN_STEP, EVENNESS)
+            c = row[:, None] + 1.0 + weight * np.where(step > 0, ((step - pref) / pref) ** 2, 0.5)
             c = np.where(valid, c, np.inf)
             best_m = np.argmin(c, axis=0)
             best = c[best_m, np.arange(len(ks))]

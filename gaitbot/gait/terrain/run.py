@@ -6,14 +6,15 @@ two-level grid search) and its mid-stance point (MS, highest, at mid-swing), and
 at the run's last heel strike, from which the next segment takes over.
 
 - MS: the highest pelvis point at mid-swing from which both legs fit (``legs.LegRange`` with a
-  spare margin), no higher than the stance knee bent MS_KNEE_RAD, preferring a point over the
-  middle of the stance sole. On level ground that is seed 003's MS; on a stair it drops or moves
-  back where the swing foot still lies far behind or below.
-- MDS: seed 003's search over the region between the two neighbouring knots (x between them, y
-  from MDS_DEPTH_SHARE leg lengths below the lower one up to the higher one), scoring a cell by
-  the supporting legs' weighted squared joint accelerations over the two Bezier segments it
-  shapes (``MdsProblem``); a cell whose MDS pose the legs cannot reach is skipped, and a cell
-  whose path leaves the legs' ranges or moves the pelvis backward scores inf.
+  spare margin), no higher than the stance knee bent MS_KNEE_RAD (MS_KNEE_DOWN_RAD on a step
+  down), preferring a point midway between the stance ankle and the middle of the swing path; a
+  few such candidates, tried in turn (``_ms_candidates``). On level ground that is seed 003's MS;
+  on a stair it drops or moves where the swing foot still lies far behind or below.
+- MDS: seed 003's search over the region between the two neighbouring knots (``_mds_region``),
+  scoring a cell by the supporting legs' weighted squared joint accelerations over the two Bezier
+  segments it shapes (``MdsProblem``); a cell whose MDS pose the legs cannot reach is skipped,
+  and a cell whose path leaves the legs' ranges or moves the pelvis backward scores INFEASIBLE
+  and more the further it is from feasible.
 - Velocities at MS and MDS: vertical 0 (they are the extremes of height), horizontal the
   Fritsch-Butland mean of the neighbouring slopes, which keeps every segment's x monotone.
 """
@@ -30,13 +31,14 @@ from .legs import LegRange
 from .pelvis import Knot, PelvisPath
 from .search import Region, SearchResult, brute_force, two_level_search
 from .step import TerrainStepSegment
-from .swing import warp
 
-MS_KNEE_RAD = np.radians(20.0)  # the pelvis at mid-stance is no higher than this stance knee bend allows
+MS_KNEE_RAD = np.radians(15.0)  # the pelvis at mid-stance is no higher than this stance knee bend allows ...
+MS_KNEE_DOWN_RAD = np.radians(8.0)  # ... or this one on a step down, where a high pelvis lets the foot behind lift
 MS_X_WEIGHT = 1.0  # how much pelvis height a knot gives up per metre nearer its preferred x
 KNOT_SPARE_RAD = np.radians(5.0)  # MS and hand-over points keep this far inside the joint ranges
 KNOT_MIN_KNEE_RAD = np.radians(15.0)  # ... and at least this knee bend, leaving the path room to move on
 MDS_DEPTH_SHARE = 0.2  # the MDS region reaches this many leg lengths below the lower neighbour
+MDS_ABOVE_SHARE = 0.05  # ... and this many above the higher one (a level pelvis inside the region, not on its edge)
 REGION_GRID = 41  # the region is cropped to what the legs reach, found on this many points a side
 COST_SAMPLES = 60
 BACKWARD_TOL = 1e-9  # metres per sample the pelvis may move backward (rounding only)
@@ -115,13 +117,10 @@ class TerrainRun:
         stance_end = last.stance_world(np.array([1.0]))[0]
         guess = Knot(float(last.time(1.0)), (0.5 * (stance_end[0] + last.landing[0]), 0.0), (0.0, 0.0), "end")
         self.knots = [start]
-        ms = []
         for k in range(len(segments)):
             after = candidates[k + 1][0] if k + 1 < len(segments) else guess
-            mds, chosen = self._mds_and_ms(k, self.knots[-1], candidates[k], after)
-            ms.append(chosen)
-            self.knots += [mds, chosen]
-        self.knots.append(self._end_knot(self.knots[-2], ms[-1]))
+            self.knots += self._mds_and_ms(k, self.knots[-1], candidates[k], after)
+        self.knots.append(self._end_knot(self.knots[-1]))
         self.path = PelvisPath(self.knots)
         for seg, w in zip(segments, self.warps):
             seg.pelvis = self.path
@@ -131,14 +130,8 @@ class TerrainRun:
         """The swing timing checked at every frame on the final path (the search samples more sparsely): the
         one chosen if it holds there, else the best at that density."""
         dense = seg.swing_frames()
-        committed = [chosen] if chosen is not None else []
-        for w in committed:
-            s = np.linspace(0.0, 1.0, dense)
-            poses, _ = seg.swing.fitted(warp(s, *w)[None], self.path(seg.swing_time(s))[None])
-            excess, q = self.swing_legs.check(poses[0], self.path(seg.swing_time(s)), False)
-            dt = seg.duration * (1.0 - seg.u_ds) / (dense - 1)
-            if excess.sum() + self.swing_legs.motion_excess(q[None], dt)[0] <= 0.0:
-                return w
+        if chosen is not None and seg.feasible_warp(self.path, self.swing_legs, samples=dense, warps=(chosen,))[1] <= 0:
+            return chosen
         return seg.feasible_warp(self.path, self.swing_legs, samples=dense)[0]
 
     # --- feet of the whole run -------------------------------------------------------------------
@@ -189,21 +182,24 @@ class TerrainRun:
         stance = seg.stance_world(np.array([u]))[0]
         middle = seg.swing.path(np.array([0.5]), lift=True)[0]
         lo_x, hi_x = min(stance[0], middle[0]) - 0.5 * g.foot, max(stance[0], middle[0]) + 0.5 * g.foot
-        y_top = stance[1] + g.leg_length * crouch_leg_scale(g, MS_KNEE_RAD)
+        down = min(seg.landing[1], seg.swing.start[1]) < stance[1] - 1e-9 or seg.swing.start[1] > stance[1] + 1e-9
+        knee = MS_KNEE_DOWN_RAD if down else MS_KNEE_RAD
+        y_top = stance[1] + g.leg_length * crouch_leg_scale(g, knee)
+        legs = self.knot_legs.with_spare(self.knot_legs.spare, min(self.knot_legs.min_knee, knee))
         gx, gy = np.meshgrid(np.linspace(lo_x, hi_x, 45), y_top - np.linspace(0.0, 0.35 * g.leg_length, 141),
                              indexing="ij")
         roots = np.column_stack([gx.ravel(), gy.ravel()])
         n = len(roots)
-        ok = self.knot_legs.fits(np.repeat(stance[None], n, axis=0), roots)
+        ok = legs.fits(np.repeat(stance[None], n, axis=0), roots)
         swing = np.zeros(n, bool)
         for pose in seg.swing.path(np.linspace(0.1, 0.9, 9), lift=True):
-            swing |= self.knot_legs.fits(np.repeat(pose[None], n, axis=0), roots, False)
+            swing |= legs.fits(np.repeat(pose[None], n, axis=0), roots, False)
         ok &= swing
         if not ok.any():
             raise GaitGenerationError(f"{seg.what}: no pelvis position at mid-stance lets both legs reach their "
                                       f"feet within the joint limits (rise or step too large for this leg)")
         out: list[Knot] = []
-        for prefer in (0.5 * (stance[0] + middle[0]), stance[0], stance[0] + 0.5 * g.foot):
+        for prefer in (0.5 * (stance[0] + middle[0]), stance[0], stance[0] + 0.5 * g.foot, middle[0]):
             score = np.where(ok, roots[:, 1] - MS_X_WEIGHT * np.abs(roots[:, 0] - prefer), -np.inf)
             best = roots[int(np.argmax(score))]
             if all(abs(best[0] - k.pos[0]) > 1e-3 * g.leg_length for k in out):
@@ -225,7 +221,7 @@ class TerrainRun:
                 first_error = first_error or exc
         raise first_error or GaitGenerationError(f"{self.segments[k].what}: the pelvis would have to move back")
 
-    def _end_knot(self, last_mds: Knot, last_ms: Knot) -> Knot:
+    def _end_knot(self, last_ms: Knot) -> Knot:
         """Where the run hands over at its last heel strike: between the feet, as high as the legs allow
         over the whole last segment (from the last MS on, which no MDS search covers), where the last
         swing finds a timing that keeps its leg in range."""
@@ -259,12 +255,15 @@ class TerrainRun:
     # --- seed 003's search -------------------------------------------------------------------------
     def _mds_region(self, prev: Knot, nxt: Knot, at_mds):
         """Seed 003's region between the two MS points (x between them, y from MDS_DEPTH_SHARE leg lengths
-        below the lower up to the higher), cropped to the box around the part of it from which both
-        legs reach their feet at the MDS instant (found on a fine grid), so that the 5 x 5 cells cover
-        what can be reached; None if nothing can."""
+        below the lower up to MDS_ABOVE_SHARE above the higher: with bent knees the cheapest pelvis often
+        barely dips, and a best point on the region's edge is one a grid of centres sees badly),
+        cropped to the box around the part of it from which both legs reach their feet at the MDS
+        instant (found on a fine grid), so that the 5 x 5 cells cover what can be reached; None if
+        nothing can."""
         depth = MDS_DEPTH_SHARE * self.ctx.geometry.leg_length
         lo_x, hi_x = sorted((prev.pos[0], nxt.pos[0]))
-        box = (lo_x, hi_x, min(prev.pos[1], nxt.pos[1]) - depth, max(prev.pos[1], nxt.pos[1]))
+        box = (lo_x, hi_x, min(prev.pos[1], nxt.pos[1]) - depth,
+               max(prev.pos[1], nxt.pos[1]) + MDS_ABOVE_SHARE * self.ctx.geometry.leg_length)
         xs, ys = np.linspace(box[0], box[1], REGION_GRID), np.linspace(box[2], box[3], REGION_GRID)
         gx, gy = np.meshgrid(xs, ys, indexing="ij")
         roots = np.column_stack([gx.ravel(), gy.ravel()])

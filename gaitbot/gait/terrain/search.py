@@ -3,8 +3,9 @@
 The region (a rectangle between two mid-stance points) is split into 5 x 5 cells and each cell
 centre is scored; cells the legs cannot reach are skipped before scoring (a cheap test at the
 MDS pose itself; a candidate that passes it but fails later scores inf). The best cell is split
-5 x 5 again and scored the same way. The finest cells are 1/625 of the region, as in a full
-25 x 25 search, but far fewer are scored: ``SearchResult`` counts them.
+5 x 5 again and scored the same way (and, where the best of those lies on the cell's edge, the
+cell across that edge once: see ``two_level_search``). The finest cells are 1/625 of the region,
+as in a full 25 x 25 search, but far fewer are scored: ``SearchResult`` counts them.
 
 ``brute_force`` scores every centre of an n x n grid over the same region: the reference the
 two-level search is tested against.
@@ -50,28 +51,43 @@ def _score(points, cost: Callable, reachable: Callable):
     return costs, evaluated, pruned
 
 
-def two_level_search(region: Region, cost: Callable, reachable: Callable, n: int = 5, levels: int = 2) -> SearchResult:
-    """Seed 003's search: ``cost(point)`` -> float (inf if infeasible), ``reachable(point)`` -> bool (cheap)."""
+def two_level_search(region: Region, cost: Callable, reachable: Callable, n: int = 5, follow: int = 1) -> SearchResult:
+    """Seed 003's search: ``cost(point)`` -> float (inf if infeasible), ``reachable(point)`` -> bool (cheap).
+
+    Level one scores the n x n cell centres of the region; level two splits the best cell n x n
+    again and scores those. Where the best of the second level lies in the outer ring of its cell,
+    the optimum may sit just across that edge (it often does: the best pelvis point presses against
+    the boundary of what the legs can reach, where a first-level centre sees nothing), so the
+    neighbouring cell across it is split and scored too, at most ``follow`` times. The finest cells
+    are 1/(n^4) of the region, as in a full n^2 x n^2 search; far fewer are scored."""
     x0, x1, y0, y1 = region
-    evaluated = pruned = 0
-    best_point, best_cost = None, np.inf
-    current = region
-    for _ in range(levels):
-        points = cell_centres(current, n)
-        costs, e, p = _score(points, cost, reachable)
-        evaluated, pruned = evaluated + e, pruned + p
-        k = int(np.argmin(costs))
-        if not np.isfinite(costs[k]):
-            break
-        if costs[k] < best_cost:
-            best_point, best_cost = points[k], float(costs[k])
-        cx, cy = points[k]
-        w, h = (current[1] - current[0]) / n, (current[3] - current[2]) / n
-        current = (cx - w / 2, cx + w / 2, cy - h / 2, cy + h / 2)
+    w, h = (x1 - x0) / n, (y1 - y0) / n
+    points = cell_centres(region, n)
+    costs, evaluated, pruned = _score(points, cost, reachable)
+    k = int(np.argmin(costs))
+    best_point, best_cost = points[k], float(costs[k])
+    if np.isfinite(best_cost):
+        queue, seen = [divmod(k, n)], set()
+        while queue:
+            i, j = queue.pop(0)
+            if (i, j) in seen:
+                continue
+            seen.add((i, j))
+            sub = cell_centres((x0 + i * w, x0 + (i + 1) * w, y0 + j * h, y0 + (j + 1) * h), n)
+            sub_costs, e, p = _score(sub, cost, reachable)
+            evaluated, pruned = evaluated + e, pruned + p
+            m = int(np.argmin(sub_costs))
+            if sub_costs[m] < best_cost:
+                best_point, best_cost = sub[m], float(sub_costs[m])
+                a, b = divmod(m, n)
+                for across in ((i + (a == n - 1) - (a == 0), j), (i, j + (b == n - 1) - (b == 0))):
+                    if across != (i, j) and 0 <= across[0] < n and 0 <= across[1] < n and follow > 0:
+                        queue.append(across)
+                        follow -= 1
     centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
     centre_cost = float(cost(centre)) if reachable(centre) else np.inf
-    point = (float(best_point[0]), float(best_point[1])) if best_point is not None else (np.nan, np.nan)
-    return SearchResult(point, best_cost, evaluated, pruned, (n * n) ** levels, centre_cost)
+    point = (float(best_point[0]), float(best_point[1])) if np.isfinite(best_cost) else (np.nan, np.nan)
+    return SearchResult(point, best_cost, evaluated, pruned, n ** 4, centre_cost)
 
 
 def brute_force(region: Region, cost: Callable, reachable: Callable, n: int = 25) -> SearchResult:

@@ -9,7 +9,7 @@ A step runs from one heel strike to the next, in two parts of its progress u:
 - swing, u in [DOUBLE_SUPPORT_U, 1]: the rear foot follows ``SwingPath`` from rest to rest and
   lands flat on its foothold;
 - heel-off, u in HEEL_OFF_U: where the landing needs it, the stance foot rises onto its toe
-  (``heel_off_pitch``), as a person's trailing foot does before the leading one lands on a stair:
+  (``_heel_off_pitch``), as a person's trailing foot does before the leading one lands on a stair:
   it lifts the ankle, and so the hip, by up to a foot length times the sine of the pitch, which
   lets the leading leg land on a higher or farther tread without bending its hip past its range.
   The foot comes to rest on its toe at the heel strike and goes on rolling in the next step.
@@ -29,7 +29,7 @@ from ..smooth import hermite_segment, smootherstep
 from .footholds import Foothold
 from .legs import LegRange
 from .model import Terrain
-from .swing import WARPS, SwingPath, warp_table
+from .swing import WARPS, SwingPath, warp, warp_table
 
 DOUBLE_SUPPORT_U = 0.25  # share of a terrain step in double support (the rear foot lifts off here)
 TERRAIN_STEP_TIME = 1.5  # a terrain step takes this many flat steps' time: higher lifts at the same joint speeds
@@ -39,6 +39,8 @@ HEEL_OFF_CHOICES_RAD = np.radians([0.0, -4.0, -8.0, -12.0, -16.0, -20.0, -25.0, 
 HEEL_OFF_ROOM = 0.5  # the least heel-off leaving the pelvis this share of the most room any heel-off leaves
 LANDING_SPARE_RAD = np.radians(3.0)  # the landing test keeps this far inside the joint ranges
 LANDING_MIN_KNEE_RAD = np.radians(8.0)
+TIP_LIFT_SHARE = 1.0  # a timing whose tipped sole needs more extra lift than this share of the clearance is out:
+# the tip grows with the lift (a higher foot bends the knee more), so large extra lifts are fragile
 FREE_ANKLE_RAD = (-np.radians(60.0), np.radians(60.0))  # the swing ankle's range when no joint ranges are given
 
 
@@ -49,7 +51,8 @@ def toe_off_pitch(pitch0: float, rate_u: float, behind: float, above: float, g, 
     by TOE_OFF_RAD, which raises its ankle towards the hip (what lets a short leg reach a long or
     rising step). A rear foot higher than the stance foot (a step down) rolls less, none from a
     tenth of a leg length up: raising it further would only bend the knee more. A foot already
-    rolling keeps rolling where its rate takes it (never back), and never past the pitch limit."""
+    rolling keeps rolling where its rate takes it, but never past the pitch limit (a foot that a
+    deep heel-off left rolled further comes back to it)."""
     higher = float(np.clip(1.0 - above / (0.1 * g.leg_length), 0.0, 1.0))
     target = -TOE_OFF_RAD * float(np.clip(behind / g.foot, 0.0, 1.0)) * higher
     coasting = pitch0 + rate_u / 3.0
@@ -154,23 +157,25 @@ class TerrainStepSegment:
         """Frames from lift-off to the heel strike (a dense check of the swing samples every one)."""
         return int(np.ceil(self.n_frames * (1.0 - self.u_ds))) + 1
 
-    def feasible_warp(self, pelvis, legs: LegRange, s_to: float = 1.0, samples: int = 31):
-        """The swing timing (``swing.WARPS``, nearest the identity first) that keeps the swing leg in its
+    def feasible_warp(self, pelvis, legs: LegRange, s_to: float = 1.0, samples: int = 31, warps=WARPS):
+        """The swing timing (of ``warps``, nearest the identity first) that keeps the swing leg in its
         ranges, and its speed and acceleration limits (``LegRange.motion_excess``), from lift-off to swing
-        progress ``s_to`` for the pelvis path ``pelvis(t)``, and 0; or, if none
-        does, the one that comes nearest and by how much (``LegRange.excess`` summed over the samples).
-        The foot is the fitted one (its sole tipped for the ankle and lifted to stay clear), so the
-        ankle keeps its range by construction and is not checked."""
+        progress ``s_to`` for the pelvis path ``pelvis(t)``, and 0; or, if none does, the one that comes
+        nearest and by how much (``LegRange.excess`` summed over the samples). The foot is the fitted
+        one (its sole tipped for the ankle and lifted to stay clear), so the ankle keeps its range by
+        construction and is not checked; a timing whose tipped sole needs more extra lift than
+        TIP_LIFT_SHARE of the clearance counts as that much beyond too."""
         s = np.linspace(0.0, s_to, samples)
         roots = pelvis(self.swing_time(s))
-        sigma = warp_table(s_to, samples)
-        poses, _ = self.swing.fitted(sigma, np.broadcast_to(roots, (len(WARPS), samples, 2)))
-        excess, q = legs.check(poses.reshape(-1, 3), np.tile(roots, (len(WARPS), 1)), False)
-        excess = excess.reshape(len(WARPS), samples).sum(axis=1)
-        excess += legs.motion_excess(q.reshape(len(WARPS), samples, 3),
+        sigma = warp_table(s_to, samples) if warps is WARPS else np.stack([warp(s, *w) for w in warps])
+        poses, extra = self.swing.fitted(sigma, np.broadcast_to(roots, (len(warps), samples, 2)))
+        excess, q = legs.check(poses.reshape(-1, 3), np.tile(roots, (len(warps), 1)), False)
+        excess = excess.reshape(len(warps), samples).sum(axis=1)
+        excess += np.maximum(extra - TIP_LIFT_SHARE * self.swing.clearance, 0.0) / self.ctx.geometry.leg_length
+        excess += legs.motion_excess(q.reshape(len(warps), samples, 3),
                                      s_to * self.duration * (1.0 - self.u_ds) / (samples - 1))
         best = int(np.argmax(excess <= 0.0)) if (excess <= 0.0).any() else int(np.argmin(excess))
-        return WARPS[best], float(excess[best])
+        return warps[best], float(excess[best])
 
     def swing_progress(self, u):
         return np.clip((np.asarray(u, dtype=float) - self.u_ds) / (1.0 - self.u_ds), 0.0, 1.0)

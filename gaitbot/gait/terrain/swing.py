@@ -7,8 +7,10 @@ surface: a rising foot reaches its new level before it travels (``LEVEL``), a fa
 it only when it has arrived. The sole levels out from its lift-off pitch early and lands flat. On
 top of that a lift, smooth and zero at both ends, is the least that keeps the sole
 
-- ``clearance`` above every tread edge it passes over (anywhere in the swing),
-- ``clearance`` above the terrain under heel and toe from 20% to 80% of the path,
+- ``clearance`` above every tread edge it passes over (anywhere in the swing: what the course asks),
+- WINDOW_SHARE of it above the surface under heel and toe from 20% to 80% of the path (off the
+  ground, never scraping along it; less than the full clearance so that a sole tipped for the
+  ankle, or a trailing foot on a step down, need not be lifted as high as over an edge),
 - above the terrain everywhere.
 
 The sole height at every sample is linear in the lift, so the least lift is found exactly on a fine
@@ -46,9 +48,11 @@ LEVEL = 0.45  # a rising foot reaches the new level by this share; a falling one
 LIFT_RISE = 0.25  # the lift rises over this share of the path (and falls over the last)
 PITCH_SHARE = 0.3  # the sole levels out over this share of the path (and tips to its landing pitch)
 TIP_RISE = 0.1  # the ankle's tipping fades in over this share of the path (none at lift-off and landing)
-CLEARANCE_WINDOW = (0.2, 0.8)  # share of the path where the whole sole keeps the clearance
+CLEARANCE_WINDOW = (0.2, 0.8)  # share of the path where the whole sole keeps WINDOW_SHARE of the clearance
+WINDOW_SHARE = 0.25
 AIM = 1.02  # aim this much above the clearance (frames fall between the samples)
 SAMPLES = 801
+FIT_ROUNDS = 12  # rounds of tip-then-lift for a tipped sole (the tip grows with the lift; it settles in a few)
 ANKLE_SPARE_RAD = np.radians(1.0)  # the swing ankle keeps this far from its limits
 ANKLE_SOFT_RAD = np.radians(10.0)  # its saturation starts this far inside the range
 _C = (0.0, 1 / 3, 2 / 3, 1.0)
@@ -124,7 +128,7 @@ class SwingPath:
         heel, toe = foot_points(g, pose[:, :2], pose[:, 2])
         inside = (sigma >= CLEARANCE_WINDOW[0]) & (sigma <= CLEARANCE_WINDOW[1])
         aim = cl * AIM + 1e-6 * g.leg_length
-        aim_window = np.where(inside, aim, 0.0)
+        aim_window = np.where(inside, WINDOW_SHARE * aim, 0.0)
         need = np.maximum(self.terrain.height_at(heel[:, 0]) + aim_window - heel[:, 1],
                           self.terrain.height_at(toe[:, 0]) + aim_window - toe[:, 1])
         span = toe[:, 0] - heel[:, 0]
@@ -159,7 +163,7 @@ class SwingPath:
         pose = base.copy()
         usable = (shape > 1e-9).reshape(w, n)
         lift = np.zeros(w) if extra is None else np.broadcast_to(np.asarray(extra, dtype=float), (w,))
-        for round_ in range(1 if extra is not None else 3):  # the tip moves with the lift a little: settle it
+        for round_ in range(1 if extra is not None else FIT_ROUNDS):
             pose[:, 1] = base[:, 1] + np.repeat(lift, n) * shape
             rel = pose[:, :2] - roots
             d = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-12)
@@ -173,7 +177,10 @@ class SwingPath:
             probe[:, 1] = base[:, 1]
             ratio = np.where(usable, (self._need(flat_sigma, probe) / np.where(shape > 1e-9, shape, 1.0)).reshape(w, n),
                              0.0)
-            lift = np.maximum(ratio.max(axis=1), 0.0)
+            needed = np.maximum(ratio.max(axis=1), 0.0)
+            if np.all(needed <= lift + 1e-7 * self.g.leg_length):
+                break  # the tip at this lift is cleared by it: settled
+            lift = np.maximum(lift, needed) + 1e-6 * self.g.leg_length  # the tip grows with the lift: go up to meet it
         pose[:, 1] = base[:, 1] + np.repeat(lift, n) * shape
         return pose.reshape(w, n, 3), lift
 

@@ -16,7 +16,7 @@ height to their root, since they assume the ground at y = 0.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -151,47 +151,41 @@ def plan_terrain_walk(ctx: GaitContext, terrain: Terrain, start: float, end: flo
     crouch = CrouchSegment(ctx, start, bend=True)
     _push(walk, LevelSegment(crouch, start_hold.height))
     state, t = crouch.end_state(), crouch.n_frames / ctx.rate_hz
-    stance, rear = start_hold, start_hold  # footholds under the stance and the rear foot
     targets = [*footholds, footholds[-1]]  # the last one: the trailing foot closes beside the leading one
+    methods = step_methods(ctx, terrain, [start_hold, start_hold, *targets], flat_max_step)
+    stance, rear = start_hold, start_hold  # footholds under the stance and the rear foot
     pending: list[TerrainStepSegment] = []
     pending_start = None
-    for i, target in enumerate(targets):
+    made = []
+    for i, (target, method) in enumerate(zip(targets, methods)):
         closing = i == len(targets) - 1
-        flat = (stance.surface == rear.surface == target.surface
-                and terrain.level_between(min(rear.heel_x, stance.heel_x), max(target.heel_x, stance.heel_x)
-                                          + ctx.geometry.foot))
         leg = "right" if state.stance_left else "left"
-        if flat and not pending:
-            seg = StepSegment(ctx, state, target.heel_x - state.anchor_stance)
-            _push(walk, LevelSegment(seg, target.height))
-            method, lift = "flat", float(seg.lift)
-            state = seg.end_state()
-        else:
-            if flat:  # close the pending run first: its end knot hands over to the flat walker
+        if method == "flat":
+            if pending:  # close the pending run first: its end knot hands over to the flat walker
                 _close_run(walk, pending, pending_start)
                 pending = []
                 state = walk.segments[-1].end_state()
-                seg = StepSegment(ctx, state, target.heel_x - state.anchor_stance)
-                _push(walk, LevelSegment(seg, target.height))
-                method, lift = "flat", float(seg.lift)
-                state = seg.end_state()
-            else:
-                if not pending:
-                    pending_start = root_and_velocity(ctx.geometry, state, stance.height) + (t,)
-                seg = TerrainStepSegment(ctx, state, stance, rear, target, terrain, settings.clearance,
-                                         _legs(ctx, settings), t, closing)
-                pending.append(seg)
-                method, lift = "terrain", float(seg.lift)
-                state = seg.provisional_end_state()
+            seg = StepSegment(ctx, state, target.heel_x - state.anchor_stance)
+            _push(walk, LevelSegment(seg, target.height))
+            state = seg.end_state()
+        else:
+            if not pending:
+                pending_start = root_and_velocity(ctx.geometry, state, stance.height) + (t,)
+            seg = TerrainStepSegment(ctx, state, stance, rear, target, terrain, settings.clearance,
+                                     _legs(ctx, settings), t, closing)
+            pending.append(seg)
+            state = seg.provisional_end_state()
+        made.append(seg)
         t_end = t + seg.n_frames / ctx.rate_hz
         walk.steps.append(TerrainStep(i + 1, leg, target.heel_x - stance.heel_x, t, t_end, target.heel_x,
-                                      target.height, method, lift, closing))
+                                      target.height, method, 0.0, closing))
         walk.heel_strikes.append(HeelStrike(t_end, leg, target.heel_x))
         t = t_end
         rear, stance = stance, target
     if pending:
         _close_run(walk, pending, pending_start)
         state = walk.segments[-1].end_state()
+    walk.steps = [replace(step, lift_m=float(seg.lift)) for step, seg in zip(walk.steps, made)]
     settle = SettleSegment(ctx, state)
     _push(walk, LevelSegment(settle, stance.height))
     last = CrouchSegment(ctx, state.anchor_stance, bend=False)
@@ -200,6 +194,43 @@ def plan_terrain_walk(ctx: GaitContext, terrain: Terrain, start: float, end: flo
     walk.trajectory = _trajectory(walk)
     _verify_limits(walk)
     return walk
+
+
+SHORT_STEP_SHARE = 0.5  # a flat step shorter than this share of the longest, next to a terrain step, is one too
+
+
+def step_methods(ctx: GaitContext, terrain: Terrain, holds: list[Foothold], flat_max_step: float) -> list[str]:
+    """"flat" or "terrain" for each step; ``holds`` are the footholds (start twice, then every target).
+
+    A step is the flat walker's where its rear, stance and target footholds share one level surface
+    with no edge between, except a short step (a closing step, a shuffle to the front of a tread)
+    right before or after a terrain step, the step after a terrain run that ends with the feet side
+    by side, and a lone flat step between two terrain steps: the flat walker brings its pelvis back
+    over the feet at a closing step and sways it back a little when it starts from the feet side by
+    side, which next to a terrain run would make the pelvis turn back (a loop in its path), and two
+    hand-overs around one flat step leave neither side room; as part of the run it keeps moving
+    forward."""
+    methods = []
+    for rear, stance, target in zip(holds, holds[1:], holds[2:]):
+        flat = (rear.surface == stance.surface == target.surface
+                and terrain.level_between(min(rear.heel_x, stance.heel_x), max(target.heel_x, stance.heel_x)
+                                          + ctx.geometry.foot))
+        methods.append("flat" if flat else "terrain")
+    steps = [t.heel_x - s.heel_x for s, t in zip(holds[1:], holds[2:])]
+    short = [abs(d) < SHORT_STEP_SHARE * flat_max_step for d in steps]
+    last = len(methods) - 1
+    for order in (range(last - 1, -1, -1), range(1, last)):  # before terrain steps, then after them
+        for i in order:
+            near = methods[i + 1] if order.step < 0 else methods[i - 1]
+            if methods[i] == "flat" and short[i] and near == "terrain":
+                methods[i] = "terrain"
+    for i in range(1, last):  # the flat walker starting from feet side by side first sways back a little
+        if methods[i] == "flat" and methods[i - 1] == "terrain" and abs(steps[i - 1]) < 1e-9:
+            methods[i] = "terrain"
+    for i in range(1, last):  # a lone flat step between two terrain steps: one run through it, not two hand-overs
+        if methods[i] == "flat" and methods[i - 1] == methods[i + 1] == "terrain":
+            methods[i] = "terrain"
+    return methods
 
 
 def _verify_limits(walk: TerrainWalk) -> None:
