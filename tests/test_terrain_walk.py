@@ -57,14 +57,15 @@ def robot(name: str) -> Robot:
 
 def fk_feet(cfg, q, root):
     """Heel and toe in the world of one leg from hip, knee, ankle flexion (own FK, section 1; the heel is
-    under the ankle)."""
+    heel_back_m behind the ankle's projection on the sole)."""
     g = cfg.geometry
     h, k, a = q[:, 0], q[:, 1], q[:, 2]
     ankle = root + np.column_stack([g.thigh_m * np.sin(h) + g.shank_m * np.sin(h - k),
                                     -g.thigh_m * np.cos(h) - g.shank_m * np.cos(h - k)])
     p = h - k + a  # sole pitch, toe up
-    heel = ankle + g.ankle_height_m * np.column_stack([np.sin(p), -np.cos(p)])
-    toe = heel + g.foot_m * np.column_stack([np.cos(p), np.sin(p)])
+    along_sole = np.column_stack([np.cos(p), np.sin(p)])
+    heel = ankle + g.ankle_height_m * np.column_stack([np.sin(p), -np.cos(p)]) - g.heel_back_m * along_sole
+    toe = heel + g.foot_m * along_sole
     return heel, toe
 
 
@@ -236,7 +237,7 @@ def test_cli_plan_generate_plot(tmp_path, capsys):
 @pytest.mark.parametrize("body, where, why", [
     ("start_m = 0.5\nlength_m = 0.05\nheight_m = 0.15\n", "tread 1", "stands 0.15 m above its neighbours"),
     ("start_m = 0.5\nlength_m = 0.6\nheight_m = 0.07\n", "tread 1", "rise 0.07 m exceeds what this leg can step "
-                                                                    "(max 0.0425 m for xl430-biped)"),
+                                                                    "(max 0.0375 m for xl430-biped)"),  # its [terrain] max_rise_m
     ("start_m = 0.5\nlength_m = 0.6\nheight_m = -0.06\n", "tread 1", "drop 0.06 m exceeds"),
     ("start_m = 0.5\nlength_m = 0.12\nheight_m = -0.2\n", "the ground after tread 1", "a gap of 0.12 m"),
     ("start_m = 0.5\nlength_m = 0.13\nheight_m = 0.03\n[[tread]]\nstart_m = 0.63\nlength_m = 0.5\nheight_m = 0.06\n",
