@@ -1,14 +1,15 @@
-"""The exceptions that mean "bad input" everywhere in gaitbot: one line, exit status 2."""
+"""The one base of every "bad input" error in gaitbot: printed as one line, exit status 2.
 
-from gaitbot.bus.log_decoder import RecordingError
-from gaitbot.bus.sim import SimUnavailable, VideoError
-from gaitbot.gait.eigen import EigenModelError, ExampleError
-from gaitbot.gait.segments import GaitGenerationError
-from gaitbot.gait.step_length import StepLengthError
-from gaitbot.gait.trajectory import TrajectoryFileError
-from gaitbot.robot.config import ConfigError
-from gaitbot.session import UsageError
-from gaitbot.terrain_file import TerrainFileError
+A leaf: it imports nothing of gaitbot, so every room can subclass it (ConfigError, TerrainFileError,
+TrajectoryFileError, StepLengthError, RecordingError, UsageError, ...) and the command line catches
+``UserError`` alone. Each subclass keeps its built-in base too (``ValueError`` mostly), so code that
+caught those still does.
+"""
 
-USER_ERRORS = (UsageError, ConfigError, StepLengthError, TrajectoryFileError, RecordingError, GaitGenerationError,
-               EigenModelError, ExampleError, TerrainFileError, SimUnavailable, VideoError)
+from __future__ import annotations
+
+
+class UserError(Exception):
+    """Input a person can fix (a file, a field, an argument); nothing was sent to a servo."""
+
+    exit_status = 2

@@ -6,8 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from gaitbot.bus import wire
-from gaitbot.cli import main
+from gaitbot.servos import wire
+from gaitbot.app.cli import main
 from gaitbot.robot.config import load_robot_config, resolve_config
 
 ROBOTS = ("xl430-biped", "sts3215-biped", "ax12a-biped")
@@ -15,7 +15,7 @@ PERIOD_S = 1.0 / 60.0
 
 
 def run_cli(capsys, *argv) -> tuple[int, str, str]:
-    """gaitbot.cli.main with ``argv``: (exit status, stdout, stderr)."""
+    """gaitbot.app.cli.main with ``argv``: (exit status, stdout, stderr)."""
     capsys.readouterr()
     code = main([str(a) for a in argv])
     out, err = capsys.readouterr()

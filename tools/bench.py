@@ -38,7 +38,7 @@ def _us(values) -> str:
 
 def bench_gait() -> None:
     from gaitbot.robot.config import default_config_path, load_robot_config
-    from gaitbot.robot.gait_setup import leg_geometry, walk_settings
+    from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 
     config = load_robot_config(default_config_path())
     geometry, settings = leg_geometry(config), walk_settings(config)
@@ -99,10 +99,10 @@ def bench_gait() -> None:
 
 def bench_stream(seconds: float) -> None:
     from gaitbot.bus.factory import make_bus
-    from gaitbot.clock import MonotonicClock
+    from gaitbot.stream.clock import MonotonicClock
     from gaitbot.robot.calibration import angles_to_ticks
     from gaitbot.robot.config import default_config_path, load_robot_config
-    from gaitbot.robot.gait_setup import leg_geometry, walk_settings
+    from gaitbot.robot.walk_settings import leg_geometry, walk_settings
     from gaitbot.stream import Streamer
 
     config = load_robot_config(default_config_path())
@@ -130,8 +130,8 @@ def bench_sim(distance_m: float = 1.0, repeats: int = 3) -> None:
     import io
     import json
 
-    from gaitbot.bus.sim.physics import SimRobot
-    from gaitbot.cli import main as gaitbot_main
+    from gaitbot.sim.physics import SimRobot
+    from gaitbot.app.cli import main as gaitbot_main
     from gaitbot.robot.config import load_robot_config, resolve_config
 
     print(f"simulated robot, `gaitbot walk --sim --distance {distance_m:g}` (median of {repeats} runs after a "

@@ -29,7 +29,7 @@ except ImportError:  # run from a checkout without installing
     from gaitbot.bus.budget import frame_budget
 
 from gaitbot.bus.factory import make_bus
-from gaitbot.robot.servo_models import servo_model
+from gaitbot.servos.models import servo_model
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import servo_emulator as se  # noqa: E402

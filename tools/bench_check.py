@@ -40,11 +40,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args(argv)
 
-    from gaitbot.check import check_trajectory, trajectory_angles_deg
-    from gaitbot.check_recording import check_recording
-    from gaitbot.cli import main as gaitbot
+    from gaitbot.check.trajectory import check_trajectory, trajectory_angles_deg
+    from gaitbot.check.recording import check_recording
+    from gaitbot.app.cli import main as gaitbot
     from gaitbot.gait.trajectory import Trajectory
-    from gaitbot.session import load_robot
+    from gaitbot.app.options import load_robot
 
     config = load_robot(args.robot)
     quiet = contextlib.redirect_stdout(io.StringIO())

@@ -26,8 +26,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from gaitbot.gait import generate_walk  # noqa: E402
 from gaitbot.gait.eigen import FitOptions, cycles_from_trajectory, fit_model, synthesize_walk, walk_label  # noqa: E402
 from gaitbot.gait.footfall import swing_clearances  # noqa: E402
-from gaitbot.robot.gait_setup import leg_geometry, walk_settings  # noqa: E402
-from gaitbot.session import load_robot  # noqa: E402
+from gaitbot.robot.walk_settings import leg_geometry, walk_settings  # noqa: E402
+from gaitbot.app.options import load_robot  # noqa: E402
 
 TRAIN_M = (0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08, 0.09)
 HELD_OUT_M = (0.025, 0.045, 0.065, 0.085)

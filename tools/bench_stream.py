@@ -28,7 +28,7 @@ except ImportError:  # run from a checkout without installing
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
     from gaitbot.bus.base import Bus
 
-from gaitbot.clock import MonotonicClock
+from gaitbot.stream.clock import MonotonicClock
 from gaitbot.stream import Streamer
 
 

@@ -17,7 +17,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a sourc
 
 
 def main(argv: list[str] | None = None) -> int:
-    from gaitbot.cli import main as gaitbot_main
+    from gaitbot.app.cli import main as gaitbot_main
 
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = ["--debug"] if "--debug" in argv else []

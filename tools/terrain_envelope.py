@@ -30,7 +30,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from gaitbot.check import check_trajectory  # noqa: E402
+from gaitbot.check.trajectory import check_trajectory  # noqa: E402
 from gaitbot.gait.segments import GaitGenerationError  # noqa: E402
 from gaitbot.gait.terrain.envelope import StepEnvelope  # noqa: E402
 from gaitbot.gait.terrain.footholds import CourseError  # noqa: E402
@@ -38,9 +38,9 @@ from gaitbot.gait.terrain.model import Terrain, Tread  # noqa: E402
 from gaitbot.gait.terrain.walk import plan_terrain_walk  # noqa: E402
 from gaitbot.gait.walker import make_context  # noqa: E402
 from gaitbot.robot.config import load_robot_config, shipped_config_names, resolve_config  # noqa: E402
-from gaitbot.robot.gait_setup import leg_geometry, walk_settings  # noqa: E402
-from gaitbot.session import GaitSource, terrain_settings  # noqa: E402
-from gaitbot.terrain_file import Course  # noqa: E402
+from gaitbot.robot.walk_settings import leg_geometry, walk_settings  # noqa: E402
+from gaitbot.app.options import GaitSource, terrain_settings  # noqa: E402
+from gaitbot.gait.terrain.course_file import Course  # noqa: E402
 
 GRID = 0.0025
 START = 0.30  # where the first tread begins (the walk starts at 0 on flat ground)

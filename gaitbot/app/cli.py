@@ -1,14 +1,23 @@
-"""The ``gaitbot`` command line: argparse subcommands wired to gaitbot.commands; no logic here.
+"""The ``gaitbot`` command line: the parser, and each subcommand handed to its module in gaitbot.app.
 
-Bad input prints one line and exits with status 2 (a traceback only with --debug).
+Bad input (any ``gaitbot.errors.UserError``) prints one line and exits with status 2; a bus that
+fails outside a walk session prints one line and exits with status 1 (a traceback only with --debug).
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 
 from gaitbot import __version__
+from gaitbot.bus.base import BusError
+from gaitbot.errors import UserError
+
+#: Subcommand -> the module of gaitbot.app whose ``run(args)`` does it (imported when used: ``plot``
+#: needs matplotlib, ``walk --sim`` MuJoCo, and the rest should not wait for them).
+COMMANDS = {name: f"gaitbot.app.{name}" for name in ("plan", "generate", "plot", "walk", "check", "eigen", "record",
+                                                     "scan")}
 
 
 def _walk_inputs(p: argparse.ArgumentParser) -> None:
@@ -137,18 +146,13 @@ def main(argv: list[str] | None = None) -> int:
             args.distance = 0.5  # the built-in demo: half a metre on the mock bus or the simulated robot
         else:
             parser.error(f"{args.command}: give --steps or --distance")
-    from gaitbot import commands
-    from gaitbot.bus.base import BusError
-    from gaitbot.errors import USER_ERRORS
-
-    handler = getattr(commands, f"cmd_{args.command}")
     try:
-        return handler(args)
-    except USER_ERRORS as exc:
+        return importlib.import_module(COMMANDS[args.command]).run(args)
+    except UserError as exc:
         if args.debug:
             raise
         print(f"gaitbot {args.command}: error: {' '.join(str(exc).split())}", file=sys.stderr)
-        return 2
+        return exc.exit_status
     except BusError as exc:  # a bus that fails outside a walk session (scan): one line, status 1
         if args.debug:
             raise

@@ -25,13 +25,14 @@ import numpy as np
 from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, cycles_from_trajectory, fit_model,
                                 synthesize_walk, walk_label)
 from gaitbot.gait.trajectory import WALKING_JOINTS, Trajectory
-from gaitbot.robot.gait_setup import leg_geometry, walk_settings
-from gaitbot.session import UsageError, load_robot, preflight
+from gaitbot.app.options import UsageError, load_robot
+from gaitbot.check.preflight import preflight
+from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 
 POSE_TOL_DEG = 0.1
 
 
-def run_eigen(args) -> int:
+def run(args) -> int:
     return {"fit": run_fit, "synth": run_synth}[args.eigen_command](args)
 
 

@@ -1,4 +1,4 @@
-"""``gaitbot record``: wiring from arguments to a bus, a question, and a trajectory CSV (gaitbot/record.py).
+"""``gaitbot record``: wiring from arguments to a bus, a question, and a trajectory CSV (gaitbot/stream/record.py).
 
 What a sample becomes (:class:`TrajectorySink`): ticks -> joint angles through the robot's
 calibration (the exact inverse of the map a walk uses) -> the root from foot contact
@@ -22,16 +22,17 @@ from pathlib import Path
 
 import numpy as np
 
-from gaitbot.bus.factory import make_bus
-from gaitbot.bus.guard import LimitGuard
-from gaitbot.clock import MonotonicClock, VirtualClock
+from gaitbot.app.hardware import serial_port
+from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
+from gaitbot.bus.factory import make_robot_bus
 from gaitbot.gait.footfall import ContactRoot
 from gaitbot.gait.trajectory import CsvTrajectoryWriter
-from gaitbot.record import record_session
-from gaitbot.robot.calibration import ticks_to_angles, tick_limits
+from gaitbot.robot.calibration import ticks_to_angles
 from gaitbot.robot.config import RobotConfig
-from gaitbot.robot.gait_setup import leg_geometry
-from gaitbot.session import UsageError, gain_notes, gain_writes, load_robot
+from gaitbot.robot.gains import gain_notes, gain_writes
+from gaitbot.robot.walk_settings import leg_geometry
+from gaitbot.stream.clock import MonotonicClock, VirtualClock
+from gaitbot.stream.record import record_session
 
 QUESTION = "Turn torque off on {n} servos? The legs will go limp. [y/N] "
 
@@ -143,9 +144,7 @@ def _status_line(rate_hz: float):
     return show
 
 
-def run_record(args) -> int:
-    from gaitbot.commands import _require_port
-
+def run(args) -> int:
     config = load_robot(args.robot)
     out = Path(args.output)
     _check_output(out)
@@ -153,14 +152,9 @@ def run_record(args) -> int:
     if args.dry_run and args.duration is None:
         raise UsageError("--dry-run needs --duration (a dry run has no hand on the legs and no Ctrl-C to wait for)")
     n_samples = samples_for(args.duration, rate_hz)
-    if args.reply_timeout_ms is not None and not (math.isfinite(args.reply_timeout_ms) and args.reply_timeout_ms > 0):
-        raise UsageError(f"--reply-timeout-ms must be a positive number of milliseconds, got {args.reply_timeout_ms!r}")
-    port = args.port or config.bus.port
-    if not args.dry_run:
-        _require_port(port)
-    bus = make_bus(config.bus.backend, config.bus.protocol, port, config.bus.baudrate, config.models_by_id,
-                   dry_run=args.dry_run, reply_timeout_ms=args.reply_timeout_ms)
-    bus = LimitGuard(bus, tick_limits(config), {j.id: j.name for j in config.joints})
+    check_reply_timeout(args.reply_timeout_ms)
+    port = serial_port(config, args.port, args.dry_run)
+    bus = make_robot_bus(config, port, dry_run=args.dry_run, reply_timeout_ms=args.reply_timeout_ms)
 
     def warn(text: str) -> None:
         print(f"warning: {text}", file=sys.stderr)

@@ -2,7 +2,7 @@
 
     make_bus(backend, protocol, port, baudrate, models, dry_run, recorder=None) -> Bus
 
-The simulated robot (gaitbot.bus.sim, needs the ``sim`` extra) is a port of its own under the same
+The simulated robot (gaitbot.sim, needs the ``sim`` extra) is a port of its own under the same
 backends; it is imported only when asked for, so MuJoCo stays optional.
 """
 

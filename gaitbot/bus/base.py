@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+
+from gaitbot.servos.registers import RegisterWrite
 
 
 class BusError(Exception):
@@ -46,25 +47,12 @@ class CorruptReplies(ServoTimeout):
 class ServoStatusError(BusError):
     """A servo answered with error bits set (overload, overheating, input voltage ...).
 
-    ``fault``: the error in words (gaitbot.bus.status.describe_status_error).
+    ``fault``: the error in words (gaitbot.servos.status.describe_status_error).
     """
 
     def __init__(self, message: str, *, fault: str = "", **kwargs) -> None:
         super().__init__(message, **kwargs)
         self.fault = fault
-
-
-@dataclass(frozen=True)
-class RegisterWrite:
-    """A setting a session writes to servos before torque goes on: ``value`` as ``length`` bytes (each
-    servo's byte order) at control-table ``address`` of every servo in ``ids``; ``name`` says what the
-    register is, for messages."""
-
-    ids: tuple[int, ...]
-    address: int
-    length: int
-    value: int
-    name: str = ""
 
 
 class Bus(ABC):
@@ -94,6 +82,12 @@ class Bus(ABC):
     def write_goal_ticks(self, goals: Mapping[int, int]) -> None:
         """Write every goal position of one frame in one sync-write packet."""
 
+    def send_goal_ticks(self, goals: Mapping[int, int]) -> None:
+        """Write goals already checked by the caller (the LimitGuard, whose limits lie inside the servos'
+        tick ranges), so that each goal is checked once on the 60 Hz path. Backends that check goals
+        themselves in write_goal_ticks override this to skip that check."""
+        self.write_goal_ticks(goals)
+
     @abstractmethod
     def read_present_ticks(self, ids: Iterable[int]) -> dict[int, int]:
         """Present positions (sync read where the protocol has it); reads retry a bounded number of times."""
@@ -111,3 +105,7 @@ class Bus(ABC):
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+__all__ = ["Bus", "BusError", "PortError", "ServoTimeout", "ServoLate", "CorruptReplies", "ServoStatusError",
+           "RegisterWrite"]

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from gaitbot.robot.servo_models import ServoModel, servo_model
+from gaitbot.robot.config import ConfigError, RobotConfig
+from gaitbot.servos import ASSUMED_RETURN_DELAY_S, BACKENDS, has_sync_read, wire
+from gaitbot.servos.models import ServoModel, servo_model
 
 BITS_PER_BYTE = 10
-# Factory Return Delay Time: 250 x 2 us on Dynamixel X, AX and XL-320 (e-Manual control tables).
-# Feetech series differ by firmware; the same 500 us is assumed as the safe (longer) figure.
-DEFAULT_RETURN_DELAY_S = 500e-6
+DEFAULT_RETURN_DELAY_S = ASSUMED_RETURN_DELAY_S
 
 
 @dataclass(frozen=True)
@@ -50,15 +50,17 @@ def frame_budget(backend: str, protocol: float, model: ServoModel | str, n_servo
     if n_servos < 1 or baudrate <= 0:
         raise ValueError(f"need n_servos >= 1 and baudrate > 0, got {n_servos} and {baudrate}")
     goal_len, present_len = model.len_goal_position, model.len_present_position
-    v2 = backend == "dynamixel" and float(protocol) == 2.0
-    if backend not in ("dynamixel", "feetech"):
-        raise ValueError(f"unknown backend {backend!r} (known: dynamixel, feetech)")
-    write = (14 if v2 else 8) + n_servos * (1 + goal_len)
+    if backend not in BACKENDS:
+        raise ValueError(f"unknown backend {backend!r} (known: {', '.join(BACKENDS)})")
+    framing = wire.framing_for(backend, protocol)
+    # an instruction with an address and a length parameter: 14 bytes on 2.0, 8 on 1.0 / Feetech
+    addressed = wire.PACKET_OVERHEAD_BYTES[framing] + 2 * wire.ADDRESS_BYTES[framing]
+    write = addressed + n_servos * (1 + goal_len)
     read = 0
     if read_back:
-        status = (11 if v2 else 6) + present_len
-        sync_read = v2 or (backend == "feetech" and model.byte_order == "little")
-        request = ((14 if v2 else 8) + n_servos) if sync_read else 8 * n_servos
+        status = wire.STATUS_OVERHEAD_BYTES[framing] + present_len
+        sync_read = has_sync_read(backend, protocol, model.byte_order)
+        request = (addressed + n_servos) if sync_read else addressed * n_servos
         read = request + n_servos * status
     return FrameBudget(write, read, n_servos if read_back else 0, return_delay_s, int(baudrate))
 
@@ -83,3 +85,18 @@ def check_rate(rate_hz: float, backend: str, protocol: float, model: ServoModel 
             f"({budget.bytes_per_frame} bytes) of a {period_s * 1e3:.1f} ms period, more than {margin:.0%}; "
             f"at most {margin / budget.wire_time_s:.1f} Hz, or raise the baud rate")
     return budget
+
+
+def check_robot_rate(config: RobotConfig, rate_hz: float) -> FrameBudget:
+    """check_rate for a robot config's bus and servos, with the read-back every session makes."""
+    return check_rate(rate_hz, config.bus.backend, config.bus.protocol, config.joints[0].model, len(config.joints),
+                      config.bus.baudrate, read_back=True)
+
+
+def bus_budget_check(config: RobotConfig) -> None:
+    """A config check (``load_robot_config(extra_checks=...)``): refuse a ``gait.rate_hz`` the bus cannot
+    carry (writes plus a read-back) with margin."""
+    try:
+        check_robot_rate(config, config.gait.rate_hz)
+    except ValueError as exc:
+        raise ConfigError(config.path, "gait.rate_hz", str(exc)) from None

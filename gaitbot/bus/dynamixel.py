@@ -44,6 +44,3 @@ class DynamixelBus(SdkBus):
         if self.protocol == 2.0:
             return StuffingProtocol2PacketHandler()
         return dynamixel_sdk.PacketHandler(1.0)  # the SDK compares with the float 1.0
-
-    def _uses_sync_read(self) -> bool:
-        return self.protocol == 2.0

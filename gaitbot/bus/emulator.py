@@ -1,100 +1,44 @@
-"""A servo chain on a pseudo-terminal: run ``gaitbot walk --port <pty>`` without hardware.
+"""A servo chain in time, with faults and a scripted hand: the engine behind tools/servo_emulator.py.
 
-Opens a pty pair, prints the device path (the end a driver opens) as the first line of its
-output, and answers like a chain of Dynamixel or Feetech servos:
+``ServoEmulator(EmulatorConfig(...))`` opens a pty pair and answers on it like a chain of Dynamixel
+or Feetech servos (``start()`` serves it on a background thread; ``path`` is the device a driver
+opens; ``stop()``, ``chain``, ``wait_closed()``). ``EmulatedChain`` is the chain alone, fed with
+``receive(data, now_s)`` and read with ``due(now_s)``, for tests without a pty.
 
-    python tools/servo_emulator.py --robot config/xl430-biped.toml --log goals.jsonl
-    python tools/servo_emulator.py --protocol dxl2 --ids 1-6 --late 3:60
-    gaitbot walk --robot config/xl430-biped.toml --distance 0.3 --port /dev/pts/N
-
-What it emulates, per servo, from the protocol documents (ROBOTIS e-Manual Protocol 1.0 / 2.0,
-Feetech SCS/STS protocol manual):
-
-* a control table with the model's real addresses (model number, firmware, id, baud rate, return
-  delay, status return level, torque enable, goal/present position, voltage, temperature, moving,
-  hardware error status, and the gain register at its factory value: a session's gain writes stay
-  in the table, to be read back);
-* ping, read, write, reg write + action, sync write, sync read (Dynamixel 2.0 and Feetech; AX-12A
-  firmware has none), bulk read and bulk write (Dynamixel 2.0), reboot; other instructions get an
-  Instruction Error status; damaged packets (bad checksum/CRC) get no answer; broadcast gets no
-  status (except ping);
-* status packets with the right checksum or CRC, Dynamixel 2.0 byte stuffing both ways, each
-  servo's Return Delay Time (x 2 us) and the byte time at the configured baud rate, replies of a
-  sync/bulk read one after the other in the requested order;
-* the Status Return Level register (Dynamixel: 0 ping only, 1 ping and reads, 2 all; Feetech:
-  0 ping and reads, 1 all);
-* motion: with torque on, present position moves towards goal position at the model's no-load
-  speed, so reads show a moving servo.
-
-Instruction parsing, packet framing and the control-table basics are gaitbot.bus.mock.MockPort's
-(the same chain the dry run talks to); this module adds time, motion and faults on a real pty.
-
-Faults (command line or ``EmulatorConfig`` from tests); all start after ``--fault-after-frames``
-goal frames and ``--fault-after-s`` seconds from the first packet received (default: at once):
-
-* ``--silent ID``: the servo never answers;
-* ``--late ID:MS``: the servo answers MS milliseconds late;
-* ``--corrupt FRACTION[:ID]``: that fraction of status packets (of one servo, or of all) has a bad
-  checksum/CRC (seeded by ``--seed``);
-* ``--error ID:KIND[+KIND]``, KIND in overload, overheating, voltage: status packets carry the
-  error bits (Dynamixel 2.0: the Alert bit and Hardware Error Status); overload and overheating
-  also switch the servo's torque off, as the servos' shutdown settings do by default;
-* ``--close-after-frames N`` / ``--close-after-s T``: the port disappears (the pty master is
-  closed and the emulator exits) after N goal frames or T seconds from the first packet.
-
-A scripted hand (``--hand FILE``, a trajectory .csv/.npz turned into ticks by ``--robot``'s
-calibration, or ``Hand`` from tests) moves the servos while their torque is off, as a person moving
-the legs for ``gaitbot record`` would: from the first torque-off write, a servo with torque off
-reports the hand's current sample as its present position. The hand advances one sample per read
-cycle (a present-position read of a servo already read at this sample starts the next one; sync
-reads, bulk reads and one read per servo all count the same way), so a recording sees every sample
-exactly once whatever the host's timing; with ``--hand-rate HZ`` it advances with time instead.
-After its last sample the hand stays there.
-
-``--log goals.jsonl`` writes every goal-position packet received in the bus recording format
-(gaitbot.bus.recording), so ``gaitbot.bus.log_decoder.decode_goal_frames`` reads it back.
-
-Importable: ``ServoEmulator(EmulatorConfig(...))`` with ``start()`` (a background thread),
-``path``, ``stop()``, ``chain`` (the emulated servos) and ``wait_closed()``.
+Instruction parsing, framing and the control tables are the mock's (gaitbot.bus.mock.MockPort, the
+chain a dry run talks to) and the vendors' (gaitbot.servos); this module adds time (return delay,
+byte time, motion at the no-load speed), the Status Return Level, the instructions a dry run never
+sends (reg write, action, reboot, bulk read/write), faults (silent, late, corrupt, error bits, a port
+that disappears) and a hand that moves servos whose torque is off. docs/emulator.md describes it;
+gaitbot.app.emulator is its command line.
 """
-
 from __future__ import annotations
 
-import argparse
+import math
 import os
 import random
 import select
-import sys
 import threading
 import time
 import tty
 from collections import deque
 from dataclasses import dataclass, field
 
-try:
-    from gaitbot.bus import wire
-except ImportError:  # run from a checkout without installing
-    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
-    from gaitbot.bus import wire
-
+from gaitbot.bus.log import BusRecorder
 from gaitbot.bus.mock import MockPort
-from gaitbot.bus.recording import BusRecorder
-from gaitbot.bus.status import ERRBIT_INPUT_VOLTAGE, ERRBIT_OVERHEATING, ERRBIT_OVERLOAD, HARDWARE_ERROR_STATUS
-from gaitbot.robot.servo_models import ServoModel, servo_model
+from gaitbot.gait.trajectory import Trajectory
+from gaitbot.robot.calibration import angles_to_ticks
+from gaitbot.servos import dynamixel, wire
+from gaitbot.servos.models import SERVO_MODELS, ServoModel
+from gaitbot.servos.wire import INST_ACTION, INST_BULK_READ, INST_BULK_WRITE, INST_REBOOT, INST_REG_WRITE
 
-#: --protocol name -> (backend, protocol, default model)
-PROTOCOLS = {"dxl1": ("dynamixel", 1.0, "AX-12A"), "dxl2": ("dynamixel", 2.0, "XL430-W250"),
-             "feetech-sts": ("feetech", 1.0, "STS3215"), "feetech-scs": ("feetech", 1.0, "SCS0009")}
-
-INST_REG_WRITE, INST_ACTION, INST_REBOOT = 0x04, 0x05, 0x08
-INST_BULK_READ, INST_BULK_WRITE = 0x92, 0x93
-V2_ALERT, V2_INSTRUCTION_ERROR, V1_INSTRUCTION_ERROR = 0x80, 0x02, 0x40
 FAULT_KINDS = ("overload", "overheating", "voltage")
 
 
 @dataclass(frozen=True)
 class Layout:
-    """Control-table addresses beyond ServoModel's, and factory values (address, size, value)."""
+    """Control-table addresses the emulator needs beyond ServoModel's, and the factory values it starts
+    with (address, size, value): all read from the vendor's control table (gaitbot.servos)."""
 
     id_addr: int
     return_delay_addr: int
@@ -103,28 +47,16 @@ class Layout:
     hardware_error_addr: int | None  # Dynamixel 2.0 Hardware Error Status
     initial: tuple[tuple[int, int, int], ...]
 
+    @classmethod
+    def of(cls, model: ServoModel) -> "Layout":
+        table = model.control_table
+        hardware = table.get("Hardware Error Status")
+        return cls(table["ID"].address, table["Return Delay Time"].address, table["Status Return Level"].address,
+                   table["Moving"].address, hardware.address if hardware is not None else None,
+                   tuple((r.address, r.size, r.factory) for r in table.values() if r.factory is not None))
 
-# Sources: ROBOTIS e-Manual control tables (XL430-W250, XM430-W350, XL-320, AX-12A); Feetech SMS/STS
-# and SCSCL memory tables (as transcribed in LeRobot's feetech tables.py).
-_X = Layout(7, 9, 68, 122, 70, ((6, 1, 46), (8, 1, 3), (9, 1, 250), (11, 1, 3), (13, 1, 2), (31, 1, 72),
-                                (32, 2, 140), (34, 2, 60), (48, 4, 4095), (52, 4, 0), (63, 1, 0x34),
-                                (68, 1, 2), (144, 2, 120), (146, 1, 30)))
-LAYOUTS = {
-    "XL430-W250": _X,
-    "XM430-W350": _X,
-    "XL-320": Layout(3, 5, 17, 49, 50, ((2, 1, 30), (4, 1, 3), (5, 1, 250), (8, 2, 1023), (11, 1, 2), (12, 1, 65),
-                                        (13, 1, 60), (14, 1, 90), (15, 2, 1023), (17, 1, 2), (18, 1, 3),
-                                        (45, 1, 74), (46, 1, 30))),
-    "AX-12A": Layout(3, 5, 16, 46, None, ((2, 1, 24), (4, 1, 1), (5, 1, 250), (8, 2, 1023), (11, 1, 70),
-                                          (12, 1, 60), (13, 1, 140), (14, 2, 1023), (16, 1, 2), (17, 1, 0x24),
-                                          (18, 1, 0x24), (34, 2, 1023), (42, 1, 120), (43, 1, 30))),
-    "STS3215": Layout(5, 7, 8, 66, None, ((0, 1, 3), (1, 1, 9), (6, 1, 0), (7, 1, 0), (8, 1, 1), (11, 2, 4095),
-                                          (13, 1, 70), (14, 1, 140), (15, 1, 40), (16, 2, 1000), (62, 1, 74),
-                                          (63, 1, 30))),
-    "SCS0009": Layout(5, 7, 8, 66, None, ((0, 1, 3), (1, 1, 9), (6, 1, 0), (7, 1, 0), (8, 1, 1), (11, 2, 1023),
-                                          (13, 1, 70), (14, 1, 80), (15, 1, 40), (16, 2, 1000), (62, 1, 60),
-                                          (63, 1, 30))),
-}
+
+LAYOUTS = {name: Layout.of(model) for name, model in SERVO_MODELS.items()}
 
 
 @dataclass
@@ -245,9 +177,11 @@ class EmulatedChain(MockPort):
         if not kinds:
             return 0
         if self.framing == "v2":
-            return V2_ALERT
-        return ((ERRBIT_OVERLOAD if "overload" in kinds else 0) | (ERRBIT_OVERHEATING if "overheating" in kinds else 0)
-                | (ERRBIT_INPUT_VOLTAGE if "voltage" in kinds else 0))
+            return dynamixel.V2_ALERT
+        bits = self.vendor  # Protocol 1.0 and Feetech: the same bits
+        return ((bits.ERRBIT_OVERLOAD if "overload" in kinds else 0)
+                | (bits.ERRBIT_OVERHEATING if "overheating" in kinds else 0)
+                | (bits.ERRBIT_INPUT_VOLTAGE if "voltage" in kinds else 0))
 
     def _apply_error_faults(self) -> None:
         if not self.faults_active():
@@ -258,7 +192,7 @@ class EmulatedChain(MockPort):
             model, table = self.models[servo_id], self.tables[servo_id]
             layout = LAYOUTS[model.name]
             if layout.hardware_error_addr is not None:
-                bits = {name: bit for bit, name in HARDWARE_ERROR_STATUS[model.name][1].items()}
+                bits = {name: bit for bit, name in dynamixel.HARDWARE_ERROR_BITS[model.name].items()}
                 value = sum(bits["input voltage" if k == "voltage" else k] for k in kinds)
                 table[layout.hardware_error_addr] = value
             if kinds & {"overload", "overheating"} and table[model.addr_torque_enable]:
@@ -278,7 +212,7 @@ class EmulatedChain(MockPort):
             script = self.hand.ticks[servo_id]
             present = self._present[servo_id] = float(script[min(self.hand_sample, len(script) - 1)])
         elif table[model.addr_torque_enable]:
-            step = model.no_load_speed_dps * model.ticks_per_rad * (3.141592653589793 / 180.0) * dt_s
+            step = model.no_load_speed_dps * model.ticks_per_rad * (math.pi / 180.0) * dt_s
             present = goal if abs(goal - present) <= step else present + step * (1 if goal > present else -1)
             self._present[servo_id] = present
         length = model.len_present_position
@@ -364,7 +298,7 @@ class EmulatedChain(MockPort):
 
     def _unsupported(self, frame: wire.Frame) -> None:
         if frame.packet_id in self.tables:
-            error = V2_INSTRUCTION_ERROR if self.framing == "v2" else V1_INSTRUCTION_ERROR
+            error = self.vendor.INSTRUCTION_ERROR[self.protocol]
             self._reply(frame.packet_id, b"", error=error)
 
     def _log_goals(self, raw: bytes, frame: wire.Frame) -> None:
@@ -548,75 +482,9 @@ class ServoEmulator:
         self._done.set()
 
 
-# --- command line ---------------------------------------------------------------------------
-def parse_ids(text: str) -> list[int]:
-    """``1-6`` / ``1,2,5`` / ``9-16,20`` -> ids."""
-    ids: list[int] = []
-    for part in text.split(","):
-        part = part.strip()
-        if "-" in part:
-            low, high = (int(x) for x in part.split("-", 1))
-            ids.extend(range(low, high + 1))
-        elif part:
-            ids.append(int(part))
-    if not ids or len(set(ids)) != len(ids) or not all(0 <= i <= 252 for i in ids):
-        raise ValueError(f"--ids {text!r}: give distinct ids 0..252, e.g. 1-6 or 1,2,5")
-    return ids
-
-
-def _id_value(text: str, what: str) -> tuple[int, str]:
-    servo_id, sep, value = text.partition(":")
-    if not sep:
-        raise ValueError(f"{what} {text!r}: expected ID:VALUE")
-    return int(servo_id), value
-
-
-def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
-    faults = Faults(after_frames=args.fault_after_frames, after_s=args.fault_after_s,
-                    close_after_frames=args.close_after_frames, close_after_s=args.close_after_s)
-    faults.silent = set(args.silent or [])
-    for item in args.late or []:
-        servo_id, value = _id_value(item, "--late")
-        faults.late_s[servo_id] = float(value) / 1000.0
-    if args.corrupt:
-        fraction, _, which = args.corrupt.partition(":")
-        faults.corrupt_fraction = float(fraction)
-        faults.corrupt_ids = {int(which)} if which else None
-        if not 0.0 <= faults.corrupt_fraction <= 1.0:
-            raise ValueError(f"--corrupt {args.corrupt!r}: the fraction must be within 0..1")
-    for item in args.error or []:
-        servo_id, value = _id_value(item, "--error")
-        kinds = set(value.split("+"))
-        if not kinds <= set(FAULT_KINDS):
-            raise ValueError(f"--error {item!r}: kinds are {', '.join(FAULT_KINDS)} (join with +)")
-        faults.errors[servo_id] = kinds
-    if args.robot:
-        from gaitbot.robot.config import load_robot_config, resolve_config
-
-        robot = load_robot_config(resolve_config(args.robot))
-        hand = hand_from_trajectory(robot, args.hand, args.hand_rate) if args.hand else None
-        return EmulatorConfig(robot.bus.backend, robot.bus.protocol, robot.models_by_id,
-                              args.baudrate or robot.bus.baudrate, faults, args.log, robot.name,
-                              {j.name: j.id for j in robot.joints}, args.seed, args.return_delay_us, hand)
-    if args.hand:
-        raise ValueError("--hand needs --robot (its calibration turns the trajectory's angles into ticks)")
-    if not args.protocol:
-        raise ValueError("give --robot CONFIG or --protocol dxl1|dxl2|feetech-sts|feetech-scs with --ids")
-    backend, protocol, default_model = PROTOCOLS[args.protocol]
-    model = servo_model(args.model or default_model)
-    if model.family != backend or protocol not in model.protocols:
-        raise ValueError(f"--model {model.name} does not speak {args.protocol}")
-    models = {i: model for i in parse_ids(args.ids)}
-    return EmulatorConfig(backend, protocol, models, args.baudrate or 1_000_000, faults, args.log,
-                          seed=args.seed, return_delay_us=args.return_delay_us)
-
-
 def hand_from_trajectory(robot, path: str, rate_hz: float | None = None) -> Hand:
     """A hand playing a trajectory file (.csv/.npz): its angles through the robot's calibration, held
     joints at their hold angle. Ticks outside a servo's encoder range cannot be reported: refused."""
-    from gaitbot.gait.trajectory import Trajectory
-    from gaitbot.robot.calibration import angles_to_ticks
-
     ticks = angles_to_ticks(robot, Trajectory.load(path).angles_rad)
     for column, joint in enumerate(robot.joints):
         low, high = int(ticks[:, column].min()), int(ticks[:, column].max())
@@ -624,60 +492,3 @@ def hand_from_trajectory(robot, path: str, rate_hz: float | None = None) -> Hand
             raise ValueError(f"--hand {path}: {joint.name} goes to ticks {low}..{high}, outside the "
                              f"{joint.model.name}'s {joint.model.min_tick}..{joint.model.max_tick}")
     return Hand({joint.id: ticks[:, column].tolist() for column, joint in enumerate(robot.joints)}, rate_hz)
-
-
-def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(description="Emulate a Dynamixel/Feetech servo chain on a pty "
-                                            "(the first line printed is the device path).")
-    p.add_argument("--robot", help="robot config (.toml path or shipped name): its bus and servos")
-    p.add_argument("--protocol", choices=sorted(PROTOCOLS), help="without --robot: the chain's protocol")
-    p.add_argument("--ids", default="1-6", help="without --robot: servo ids, e.g. 1-6 or 1,2,5 (default 1-6)")
-    p.add_argument("--model", help="without --robot: servo model (default per protocol)")
-    p.add_argument("--baudrate", type=int, help="byte time of replies (default: the config's or 1000000)")
-    p.add_argument("--return-delay-us", type=float, help="override every servo's Return Delay Time")
-    p.add_argument("--log", help="write every goal packet received to this .jsonl (bus recording format)")
-    p.add_argument("--seed", type=int, default=0, help="random seed of --corrupt")
-    p.add_argument("--silent", type=int, action="append", metavar="ID", help="this servo never answers")
-    p.add_argument("--late", action="append", metavar="ID:MS", help="this servo answers MS ms late")
-    p.add_argument("--corrupt", metavar="FRACTION[:ID]", help="damage this fraction of replies (of one servo)")
-    p.add_argument("--error", action="append", metavar="ID:KIND[+KIND]",
-                   help=f"status error bits on this servo's replies; KIND in {', '.join(FAULT_KINDS)}")
-    p.add_argument("--fault-after-frames", type=int, default=0, help="faults start after this many goal frames")
-    p.add_argument("--fault-after-s", type=float, default=0.0, help="faults start this long after the first packet")
-    p.add_argument("--close-after-frames", type=int, help="the port disappears after this many goal frames")
-    p.add_argument("--close-after-s", type=float, help="the port disappears this long after the first packet")
-    p.add_argument("--hand", metavar="FILE", help="with --robot: a trajectory (.csv/.npz) a hand plays on the servos "
-                   "while their torque is off, one sample per read cycle")
-    p.add_argument("--hand-rate", type=float, metavar="HZ", help="advance the --hand script with time at HZ instead")
-    return p
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    try:
-        config = config_from_args(args)
-    except (ValueError, KeyError, OSError) as exc:
-        print(f"servo_emulator: error: {exc}", file=sys.stderr)
-        return 2
-    emulator = ServoEmulator(config)
-    print(emulator.path, flush=True)
-    names = sorted({m.name for m in config.models.values()})
-    print(f"emulating {len(config.models)} {'/'.join(names)} servos (ids {sorted(config.models)}) on "
-          f"{config.backend} protocol {config.protocol}; Ctrl-C to stop", file=sys.stderr, flush=True)
-    try:
-        emulator.serve()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        emulator.stop()
-    if emulator.closed_reason:
-        print(f"servo_emulator: {emulator.closed_reason}", file=sys.stderr)
-    if config.log_path:
-        print(f"servo_emulator: {emulator.chain.goal_frames} goal frames logged to {config.log_path}",
-              file=sys.stderr)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -7,11 +7,15 @@ from collections.abc import Mapping
 from gaitbot.bus.base import Bus
 from gaitbot.bus.dynamixel import DynamixelBus
 from gaitbot.bus.feetech import FeetechBus
+from gaitbot.bus.guard import LimitGuard
+from gaitbot.bus.log import BusRecorder
 from gaitbot.bus.mock import MockPort
-from gaitbot.bus.recording import BusRecorder
-from gaitbot.robot.servo_models import ServoModel
+from gaitbot.robot.calibration import tick_limits
+from gaitbot.robot.config import RobotConfig
+from gaitbot.servos.models import ServoModel
 
-BACKENDS = {"dynamixel": DynamixelBus, "feetech": FeetechBus}
+#: Backend name (gaitbot.servos.BACKENDS) -> its bus class.
+BUS_CLASSES: dict[str, type] = {cls.family: cls for cls in (DynamixelBus, FeetechBus)}
 
 
 def make_bus(backend: str, protocol: float, port: str, baudrate: int, models: Mapping[int, ServoModel],
@@ -23,16 +27,36 @@ def make_bus(backend: str, protocol: float, port: str, baudrate: int, models: Ma
     opened here; use it as a context manager or call open(). ``reply_timeout_ms`` replaces the
     SDK's reply timeout (2 x 16 ms USB latency + 2 ms + the packet's bytes) when set.
     """
-    try:
-        cls = BACKENDS[backend]
-    except KeyError:
-        raise ValueError(f"unknown bus backend {backend!r} (known: {', '.join(BACKENDS)})") from None
+    cls = bus_class(backend)
     handler = MockPort(backend, protocol, models, port_name=port) if dry_run else cls.sdk.PortHandler(port)
     if reply_timeout_ms is not None and not dry_run:
         _set_reply_timeout(handler, reply_timeout_ms)
     if recorder is not None:
         handler = recorder.wrap(handler, backend=backend, protocol=protocol, baudrate=baudrate, models=models)
     return cls(port, baudrate, protocol, models, port_handler=handler, retries=retries)
+
+
+def bus_class(backend: str) -> type:
+    """The Bus class of ``backend``; ValueError naming the known ones."""
+    try:
+        return BUS_CLASSES[backend]
+    except KeyError:
+        raise ValueError(f"unknown bus backend {backend!r} (known: {', '.join(BUS_CLASSES)})") from None
+
+
+def guarded(config: RobotConfig, bus: Bus) -> LimitGuard:
+    """``bus`` behind the LimitGuard of ``config``'s joint limits: every goal checked, once, before a byte is sent."""
+    return LimitGuard(bus, tick_limits(config), {j.id: j.name for j in config.joints})
+
+
+def make_robot_bus(config: RobotConfig, port: str | None = None, *, dry_run: bool = False,
+                   recorder: BusRecorder | None = None, reply_timeout_ms: float | None = None) -> LimitGuard:
+    """The bus of a robot config (on ``port``, default the config's), wrapped in its LimitGuard.
+
+    Not opened: use it as a context manager, or hand it to a session."""
+    bus = make_bus(config.bus.backend, config.bus.protocol, port or config.bus.port, config.bus.baudrate,
+                   config.models_by_id, dry_run=dry_run, recorder=recorder, reply_timeout_ms=reply_timeout_ms)
+    return guarded(config, bus)
 
 
 def _set_reply_timeout(handler, reply_timeout_ms: float) -> None:

@@ -45,8 +45,3 @@ class FeetechBus(SdkBus):
 
     def _before_transaction(self) -> None:
         scservo_def.SCS_SETEND(self.scs_end)
-
-    def _uses_sync_read(self) -> bool:
-        """STS/SMS firmware answers SYNC READ (0x82); SCS firmware is read servo by servo (Feetech's
-        own SCSCL library offers no sync read for it)."""
-        return self.byte_order == "little"

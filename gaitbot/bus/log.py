@@ -1,32 +1,299 @@
-"""Read a bus log written by BusRecorder back into packets and goal frames.
+"""The bus-log format (``gaitbot-bus-log``, JSON Lines): its writer and its one reader.
 
-Used by the limit-check tool: ``decode_goal_frames`` turns a recorded run into goal ticks over
-time, and ``parse_recording`` exposes every packet's fields for other checks.
+A recording holds every byte a bus sent and received, so a run (real, dry or simulated) can be
+checked afterwards (gaitbot.check.recording). One module for the format, as python-can keeps one
+per log format: the writer wraps any PortHandler-like object (the SDK's real one or MockPort) and
+writes a header object, then one object per packet::
 
-Truncated last line: a run killed mid-write can leave a final line without its newline. By
-default that is an error (RecordingError naming the file and line), because silently shortening a
-run could hide the very frames a limit check is about. ``allow_partial_last_line=True`` drops that
-one line and nothing else; a damaged line anywhere else is always an error.
+    {"format": "gaitbot-bus-log", "version": 1, "backend": "dynamixel", "protocol": 2.0,
+     "baudrate": 1000000, "robot": "...", "joints": {"hip_pitch_left": 1, ...}, "models": {"1": "XL430-W250"}}
+    {"t": 0.0123, "dir": "tx", "hex": "fffffd00..."}
+
+Each line is written with one write() and flushed, so after a crash or Ctrl-C every line but
+possibly the last is complete. Received bytes are coalesced into whole status packets using the
+protocol's framing; stray bytes are logged as their own rx line when the next instruction is sent.
+
+The reader (:func:`read_log`) validates the header and every line. A truncated last line (no
+newline: the writer was interrupted) is an error unless ``allow_partial_last_line``, because
+silently shortening a run could hide the very frames a check is about; a line whose hex is not hex
+is kept with its problem, for the checks to report. docs/file-formats.md describes the format.
 """
 
 from __future__ import annotations
 
 import json
+import math
+import time
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any, TextIO
 
 import numpy as np
 
-from gaitbot.bus import wire
-from gaitbot.robot.servo_models import servo_model
+from gaitbot.errors import UserError
+from gaitbot.servos import BACKENDS, wire
+from gaitbot.servos.models import ServoModel, servo_model
 
 LOG_FORMAT = "gaitbot-bus-log"
 LOG_VERSION = 1
 _HEADER_KEYS = ("backend", "protocol", "baudrate", "robot", "joints", "models")
 
 
-class RecordingError(ValueError):
+class RecordingError(UserError, ValueError):
     """A bus log cannot be read; the message names the file, the line and the problem."""
+
+
+# ---------------------------------------------------------------------------------------------- writing
+
+
+class BusRecorder:
+    """Writes one bus log. ``clock`` returns seconds (monotonic); injectable for tests."""
+
+    def __init__(self, path: str | Path, *, robot: str, joints: Mapping[str, int],
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        self.path = Path(path)
+        self.robot = robot
+        self.joints = dict(joints)
+        self._clock = clock
+        self._t0_s: float | None = None
+        self._file: TextIO | None = None
+
+    def start(self, *, backend: str, protocol: float, baudrate: int, models: Mapping[int, ServoModel]) -> None:
+        """Open the file and write the header; the clock's zero is now."""
+        if self._file is not None:
+            raise RuntimeError(f"recorder {self.path} already started")
+        header = {"format": LOG_FORMAT, "version": LOG_VERSION, "backend": backend, "protocol": float(protocol),
+                  "baudrate": int(baudrate), "robot": self.robot, "joints": self.joints,
+                  "models": {str(i): m.name for i, m in models.items()}}
+        self._file = open(self.path, "w", encoding="utf-8")
+        self._t0_s = self._clock()
+        self._write_line(header)
+
+    def wrap(self, port_handler: Any, *, backend: str, protocol: float, baudrate: int,
+             models: Mapping[int, ServoModel]) -> "RecordingPort":
+        """Start the log and return a port that logs through this recorder."""
+        self.start(backend=backend, protocol=protocol, baudrate=baudrate, models=models)
+        return RecordingPort(port_handler, self, wire.framing_for(backend, protocol))
+
+    def log(self, direction: str, data: bytes) -> None:
+        if self._file is None or self._t0_s is None:
+            raise RuntimeError(f"recorder {self.path} not started")
+        t_s = round(self._clock() - self._t0_s, 6)
+        self._write_line({"t": t_s, "dir": direction, "hex": bytes(data).hex()})
+
+    def close(self) -> None:
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __enter__(self) -> "BusRecorder":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def _write_line(self, obj: dict) -> None:
+        assert self._file is not None
+        self._file.write(json.dumps(obj, separators=(",", ":")) + "\n")
+        self._file.flush()
+
+
+class RecordingPort:
+    """A PortHandler wrapper that logs tx packets and rx packets; everything else passes through."""
+
+    def __init__(self, inner: Any, recorder: BusRecorder, framing: str) -> None:
+        self._inner = inner
+        self._recorder = recorder
+        self._framing = framing
+        self._rx_pending = bytearray()
+        self.is_using = False  # the SDK's lock lives on the object it talks to
+
+    def __getattr__(self, name: str) -> Any:  # port_name, baudrate, ser, getBaudRate, setPacketTimeout ...
+        return getattr(self._inner, name)
+
+    def writePort(self, packet) -> int:  # noqa: N802 (SDK name)
+        self._flush_rx(partial=True)
+        written = self._inner.writePort(packet)
+        self._recorder.log("tx", bytes(packet))
+        return written
+
+    def readPort(self, length: int):  # noqa: N802
+        data = self._inner.readPort(length)
+        if data:
+            self._rx_pending += bytes(data)
+            self._flush_rx(partial=False)
+        return data
+
+    def clearPort(self) -> None:  # noqa: N802
+        self._flush_rx(partial=True)
+        self._inner.clearPort()
+
+    def reset_input_buffer(self) -> None:
+        self._flush_rx(partial=True)
+        reset = getattr(self._inner, "reset_input_buffer", None)
+        if callable(reset):
+            reset()
+        elif getattr(self._inner, "ser", None) is not None:
+            self._inner.ser.reset_input_buffer()
+
+    def closePort(self) -> None:  # noqa: N802
+        try:
+            self._flush_rx(partial=True)
+            self._inner.closePort()
+        finally:  # a port that is already gone must not leave the recording unflushed
+            self._recorder.close()
+
+    def _flush_rx(self, partial: bool) -> None:
+        for chunk, _is_packet in wire.split_complete(self._rx_pending, self._framing):
+            self._recorder.log("rx", chunk)
+        if partial and self._rx_pending:
+            self._recorder.log("rx", bytes(self._rx_pending))
+            self._rx_pending.clear()
+
+
+# ---------------------------------------------------------------------------------------------- reading
+
+
+@dataclass(frozen=True)
+class LogLine:
+    """One packet line: ``data`` as sent or received, or None with ``problem`` when its hex is not hex."""
+
+    line_no: int
+    t_s: float
+    direction: str  # "tx" or "rx"
+    hex: str
+    data: bytes | None
+    problem: str = ""
+
+
+@dataclass(frozen=True)
+class BusLog:
+    """A read bus log: the validated header (joints name -> id, models id -> name, protocol a float),
+    every packet line, and the line number of a truncated last line that was dropped (None: none)."""
+
+    path: Path
+    header: dict
+    lines: list[LogLine]
+    dropped_partial_line: int | None = None
+
+    @property
+    def framing(self) -> str:
+        return wire.framing_for(self.header["backend"], self.header["protocol"])
+
+
+def is_bus_log(path: str | Path) -> bool:
+    """A bus log (JSON Lines) rather than a trajectory file: a ``.jsonl`` file, or any other file
+    (not ``.csv``/``.npz``) whose first character is ``{``."""
+    path = Path(path)
+    if path.suffix == ".jsonl":
+        return True
+    if path.suffix in (".csv", ".npz") or not path.is_file():
+        return False
+    try:
+        with open(path, "rb") as f:
+            return f.read(64).lstrip()[:1] == b"{"
+    except OSError:
+        return False
+
+
+def read_log(path: str | Path, *, allow_partial_last_line: bool = False) -> BusLog:
+    """The header and every packet line of a bus log. Raises RecordingError (exit 2) for a file that
+    cannot be read as a bus log; bad bytes inside a packet are left for the checks."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise RecordingError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise RecordingError(f"{path}: cannot read ({exc})") from None
+    lines = text.split("\n")
+    dropped = None
+    if lines and lines[-1] == "":
+        lines.pop()
+    elif lines and lines[-1].strip():
+        dropped = len(lines)
+        if not allow_partial_last_line:
+            raise RecordingError(f"{path}:{dropped}: truncated last line (no newline: the file was cut short, "
+                                 "e.g. by a crash while writing); pass --allow-partial to check the complete lines")
+        lines.pop()
+    if not lines or not lines[0].strip():
+        raise RecordingError(f"{path}:1: empty file, no {LOG_FORMAT} header")
+    header = _header(path, lines[0])
+    packets = [_line(path, n, line) for n, line in enumerate(lines[1:], start=2) if line.strip()]
+    return BusLog(path, header, packets, dropped)
+
+
+def read_header(path: str | Path) -> dict:
+    """The validated header alone (the first line), without reading the rest of the file."""
+    path = Path(path)
+    try:
+        with open(path, encoding="utf-8") as f:
+            first = f.readline()
+    except FileNotFoundError:
+        raise RecordingError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise RecordingError(f"{path}: cannot read ({exc})") from None
+    if not first.strip():
+        raise RecordingError(f"{path}:1: empty file, no {LOG_FORMAT} header")
+    return _header(path, first)
+
+
+def _header(path: Path, line: str) -> dict:
+    try:
+        header = json.loads(line)
+    except json.JSONDecodeError as exc:
+        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (line 1 is not JSON: {exc.msg})") from None
+    if not isinstance(header, dict) or header.get("format") != LOG_FORMAT:
+        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (the first line must be "
+                             f"{{\"format\": \"{LOG_FORMAT}\", ...}}; is the file a bus recording, complete from its start?)")
+    if header.get("version") != LOG_VERSION:
+        raise RecordingError(f"{path}:1: unsupported log version {header.get('version')!r} (reads {LOG_VERSION})")
+    missing = [k for k in _HEADER_KEYS if k not in header]
+    if missing:
+        raise RecordingError(f"{path}:1: header lacks {', '.join(missing)}")
+    joints, models = header["joints"], header["models"]
+    if not isinstance(joints, dict) or not isinstance(models, dict):
+        raise RecordingError(f"{path}:1: header joints and models must be objects")
+    try:
+        header["joints"] = {str(k): int(v) for k, v in joints.items()}
+        header["models"] = {int(k): str(v) for k, v in models.items()}
+        header["protocol"] = float(header["protocol"])
+        for name in header["models"].values():
+            servo_model(name)
+    except (TypeError, ValueError, KeyError) as exc:
+        raise RecordingError(f"{path}:1: bad header joints/models/protocol: {exc}") from None
+    if header["backend"] not in BACKENDS:
+        raise RecordingError(f"{path}:1: unknown backend {header['backend']!r} ({' or '.join(BACKENDS)})")
+    return header
+
+
+def _line(path: Path, line_no: int, line: str) -> LogLine:
+    try:
+        obj = json.loads(line)
+    except json.JSONDecodeError as exc:
+        raise RecordingError(f"{path}:{line_no}: bad JSON ({exc.msg}); not a bus recording line") from None
+    if not isinstance(obj, dict) or not all(k in obj for k in ("t", "dir", "hex")):
+        raise RecordingError(f"{path}:{line_no}: not a packet line (needs t, dir, hex)")
+    try:
+        t_s = float(obj["t"])
+    except (TypeError, ValueError):
+        raise RecordingError(f"{path}:{line_no}: t is not a number: {obj['t']!r}") from None
+    if not math.isfinite(t_s):
+        raise RecordingError(f"{path}:{line_no}: t is not a finite number: {obj['t']!r}")
+    direction, hex_text = obj["dir"], obj["hex"]
+    if direction not in ("tx", "rx"):
+        raise RecordingError(f"{path}:{line_no}: dir must be \"tx\" or \"rx\", got {direction!r}")
+    if not isinstance(hex_text, str):
+        raise RecordingError(f"{path}:{line_no}: hex must be a string")
+    try:
+        data = bytes.fromhex(hex_text)
+    except ValueError:
+        return LogLine(line_no, t_s, direction, hex_text, None, "bytes are not valid hex (corrupted line)")
+    return LogLine(line_no, t_s, direction, hex_text, data)
+
+
+# ---------------------------------------------------------------------------------------------- packets
 
 
 @dataclass(frozen=True)
@@ -65,22 +332,12 @@ class ParsedPacket:
 
 
 def read_recording(path: str | Path, *, allow_partial_last_line: bool = False) -> tuple[dict, list[RecordedPacket]]:
-    """The header and every logged chunk, validated line by line."""
-    path = Path(path)
-    text = path.read_text(encoding="utf-8")
-    lines = text.split("\n")
-    if lines and lines[-1] == "":
-        lines.pop()
-    elif lines:  # last line lacks its newline: the writer was interrupted
-        if not allow_partial_last_line:
-            raise RecordingError(f"{path}:{len(lines)}: truncated last line (no newline; the run was probably "
-                                 "interrupted while writing). Pass allow_partial_last_line=True to ignore it.")
-        lines.pop()
-    if not lines:
-        raise RecordingError(f"{path}:1: empty file, no {LOG_FORMAT} header")
-    header = _header(path, lines[0])
-    packets = [_packet(path, n, line) for n, line in enumerate(lines[1:], start=2)]
-    return header, packets
+    """The header and every logged chunk; a line whose bytes are not hex is an error here."""
+    log = read_log(path, allow_partial_last_line=allow_partial_last_line)
+    for line in log.lines:
+        if line.data is None:
+            raise RecordingError(f"{log.path}:{line.line_no}: {line.problem}")
+    return log.header, [RecordedPacket(p.line_no, p.t_s, p.direction, p.data) for p in log.lines]
 
 
 def parse_recording(path: str | Path, *, allow_partial_last_line: bool = False) -> tuple[dict, list[ParsedPacket]]:
@@ -130,35 +387,6 @@ def decode_goal_frames(path: str | Path, *, allow_partial_last_line: bool = Fals
     return header, np.array(times, dtype=float), ticks
 
 
-# --- internals ----------------------------------------------------------------------------
-def _header(path: Path, line: str) -> dict:
-    try:
-        header = json.loads(line)
-    except json.JSONDecodeError as exc:
-        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (line 1 is not JSON: {exc.msg})") from None
-    if not isinstance(header, dict) or header.get("format") != LOG_FORMAT:
-        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (first line has no \"format\": \"{LOG_FORMAT}\")")
-    if header.get("version") != LOG_VERSION:
-        raise RecordingError(f"{path}:1: unsupported log version {header.get('version')!r} (reads {LOG_VERSION})")
-    missing = [k for k in _HEADER_KEYS if k not in header]
-    if missing:
-        raise RecordingError(f"{path}:1: header lacks {', '.join(missing)}")
-    return header
-
-
-def _packet(path: Path, line_no: int, line: str) -> RecordedPacket:
-    try:
-        obj = json.loads(line)
-        t_s, direction, data = float(obj["t"]), obj["dir"], bytes.fromhex(obj["hex"])
-    except json.JSONDecodeError as exc:
-        raise RecordingError(f"{path}:{line_no}: bad JSON ({exc.msg})") from None
-    except (KeyError, TypeError, ValueError) as exc:
-        raise RecordingError(f"{path}:{line_no}: not a packet line (needs t, dir, hex): {exc}") from None
-    if direction not in ("tx", "rx"):
-        raise RecordingError(f"{path}:{line_no}: dir must be \"tx\" or \"rx\", got {direction!r}")
-    return RecordedPacket(line_no, t_s, direction, data)
-
-
 def _instruction_fields(frame: wire.Frame, framing: str):
     """ids, address, data_length, data, per_id_data of an instruction packet."""
     params, wide = frame.params, framing == "v2"
@@ -185,10 +413,7 @@ def _instruction_fields(frame: wire.Frame, framing: str):
 
 def _goal_layout(path: Path, header: dict) -> tuple[tuple[int, int], dict[int, str]]:
     """((goal address, length), {id: byte order}) from the header's models."""
-    try:
-        models = {int(i): servo_model(name) for i, name in header["models"].items()}
-    except (KeyError, ValueError) as exc:
-        raise RecordingError(f"{path}:1: header models: {exc}") from None
+    models = {i: servo_model(name) for i, name in header["models"].items()}
     layouts = {(m.addr_goal_position, m.len_goal_position) for m in models.values()}
     if len(layouts) != 1:
         raise RecordingError(f"{path}:1: header models do not share one goal-position address")

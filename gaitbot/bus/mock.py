@@ -2,7 +2,7 @@
 
 MockPort stands where the SDK's PortHandler stands (the httpx MockTransport idea): the real
 DynamixelBus / FeetechBus and the real SDK packet code run on top of it, so a dry run produces
-byte for byte what a real run would send. It parses each instruction packet with gaitbot.bus.wire
+byte for byte what a real run would send. It parses each instruction packet with gaitbot.servos.wire
 (written from the protocol documents, not from the SDK) and answers as the servos would:
 
 * ping: status packet (Dynamixel 2.0 adds model number and firmware version);
@@ -20,20 +20,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from gaitbot.bus import wire
-from gaitbot.robot.servo_models import ServoModel
+from gaitbot.servos import dynamixel, vendor, wire
+from gaitbot.servos.models import ServoModel
 
-# Model numbers returned by ping / stored at the model-number address (e-Manual control tables;
-# Feetech via LeRobot's MODEL_NUMBER_TABLE).
-MODEL_NUMBERS = {"XL430-W250": 1060, "XM430-W350": 1020, "XL-320": 350, "AX-12A": 12, "STS3215": 777,
-                 "SCS0009": 1284}
-_FIRMWARE_VERSION = 45
-# Baud rates each SDK's PortHandler accepts, so a dry run refuses what a real run would refuse.
-SDK_BAUDRATES = {
-    "dynamixel": (9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 576000, 921600, 1000000,
-                  1152000, 2000000, 2500000, 3000000, 3500000, 4000000),
-    "feetech": (4800, 9600, 14400, 19200, 38400, 57600, 115200, 128000, 250000, 500000, 1000000),
-}
 _TABLE_SIZE_BYTES = 1024
 
 
@@ -45,8 +34,7 @@ class MockPort:
 
     def __init__(self, backend: str, protocol: float, models: Mapping[int, ServoModel],
                  port_name: str = "mock") -> None:
-        if backend not in SDK_BAUDRATES:
-            raise ValueError(f"unknown backend {backend!r} (known: {', '.join(SDK_BAUDRATES)})")
+        self.vendor = vendor(backend)  # ValueError for an unknown backend
         self.backend = backend
         self.protocol = float(protocol)
         self.framing = wire.framing_for(backend, protocol)
@@ -72,7 +60,7 @@ class MockPort:
         self.is_open = False
 
     def setBaudRate(self, baudrate: int) -> bool:  # noqa: N802
-        if baudrate not in SDK_BAUDRATES[self.backend]:
+        if baudrate not in self.vendor.SDK_BAUDRATES:
             return False
         self.baudrate = baudrate
         return True
@@ -139,8 +127,8 @@ class MockPort:
     # --- the emulated chain ----------------------------------------------------------------
     def _initial_table(self, model: ServoModel) -> bytearray:
         table = bytearray(_TABLE_SIZE_BYTES)
-        number_addr = 0 if self.backend == "dynamixel" else 3
-        table[number_addr:number_addr + 2] = MODEL_NUMBERS.get(model.name, 0).to_bytes(2, model.byte_order)
+        number = model.control_table["Model Number"]
+        table[number.address:number.address + number.size] = model.model_number.to_bytes(number.size, model.byte_order)
         centre = model.centre_tick.to_bytes(model.len_goal_position, model.byte_order)
         table[model.addr_goal_position:model.addr_goal_position + model.len_goal_position] = centre
         table[model.addr_present_position:model.addr_present_position + model.len_present_position] = \
@@ -177,8 +165,8 @@ class MockPort:
         for servo_id in self._targets(frame.packet_id):
             extra = b""
             if self.framing == "v2":
-                number = MODEL_NUMBERS.get(self.models[servo_id].name, 0)
-                extra = bytes([number & 0xFF, number >> 8, _FIRMWARE_VERSION])
+                number = self.models[servo_id].model_number
+                extra = bytes([number & 0xFF, number >> 8, dynamixel.PING_FIRMWARE_VERSION])
             self._reply(servo_id, extra)
 
     def _read(self, frame: wire.Frame) -> None:

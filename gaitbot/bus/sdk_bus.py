@@ -13,10 +13,10 @@ from contextlib import contextmanager
 from types import ModuleType
 from typing import Any
 
-from gaitbot.bus import wire
 from gaitbot.bus.base import Bus, BusError, CorruptReplies, PortError, ServoLate, ServoStatusError, ServoTimeout
-from gaitbot.bus.status import HARDWARE_ERROR_STATUS, V2_ALERT, describe_status_error
-from gaitbot.robot.servo_models import ServoModel
+from gaitbot.servos import dynamixel, has_sync_read, max_servo_id, wire
+from gaitbot.servos.models import ServoModel
+from gaitbot.servos.status import describe_status_error, hardware_error_address
 
 try:  # pyserial raises termios.error (not an OSError) from tcflush on a hung-up terminal
     import termios
@@ -104,6 +104,8 @@ class SdkBus(Bus):
         self._torque_addr = first.addr_torque_enable
         self.port = port_handler if port_handler is not None else self.sdk.PortHandler(port_name)
         self._ph: Any = None
+        self._goal_group: Any = None  # one GroupSyncWrite per bus, its data changed frame by frame
+        self._read_group: Any = None  # one GroupSyncRead per bus, re-addressed only when the ids change
         self._is_open = False
         self._timed_out_ids: set[int] = set()  # servos whose last attempt timed out (late-reply evidence)
         self.open_notes: list[str] = []  # how the port was opened, when that differs from the config
@@ -113,7 +115,8 @@ class SdkBus(Bus):
         raise NotImplementedError
 
     def _uses_sync_read(self) -> bool:
-        raise NotImplementedError
+        first = next(iter(self.models.values()))
+        return has_sync_read(self.family, self.protocol, first.byte_order)
 
     def _before_transaction(self) -> None:
         """Called before every exchange (Feetech re-asserts its process-wide byte order)."""
@@ -121,7 +124,7 @@ class SdkBus(Bus):
     # --- validation -----------------------------------------------------------------------
     def _check_models(self) -> None:
         where = f"{type(self).__name__} on {self.port_name}"
-        max_id = 252 if self.protocol == 2.0 else 253
+        max_id = max_servo_id(self.family, self.protocol)
         for servo_id, model in self.models.items():
             if not 0 <= servo_id <= max_id:
                 raise ValueError(f"{where}: servo id {servo_id} outside 0..{max_id}")
@@ -140,6 +143,9 @@ class SdkBus(Bus):
     # --- Bus API --------------------------------------------------------------------------
     def open(self) -> None:
         self._ph = self._make_packet_handler()
+        self._goal_group = self.sdk.GroupSyncWrite(self.port, self._ph, *self._goal)
+        self._read_group = self.sdk.GroupSyncRead(self.port, self._ph, *self._present) \
+            if self._uses_sync_read() else None
         try:
             opened = self.port.openPort() and self._set_baud_rate()
         except PORT_EXCEPTIONS as exc:  # serial.SerialException is an OSError
@@ -246,26 +252,43 @@ class SdkBus(Bus):
                              f"unsigned value that fits (got {length} bytes)")
         for servo_id in ids:
             model = self._model(servo_id)
-            for start, size, what in ((model.addr_goal_position, model.len_goal_position, "write_goal_ticks"),
-                                      (model.addr_torque_enable, 1, "set_torque")):
-                if address < start + size and start < address + length:
-                    raise ValueError(f"register write at address {address} ({length} bytes) would touch servo "
-                                     f"{servo_id}'s register at {start}; use {what}")
+            touched = model.command_register_touched(address, length)
+            if touched is not None:
+                raise ValueError(f"register write at address {address} ({length} bytes) would touch servo "
+                                 f"{servo_id}'s register at {touched[0]}; use {touched[1]}")
             self._write_confirmed(servo_id, address, int(value).to_bytes(length, model.byte_order))
 
     def write_goal_ticks(self, goals: Mapping[int, int]) -> None:
+        """Refuses a goal outside the servo model's tick range (the bytes could not say it), then sends."""
         self._require_open()
-        address, length = self._goal
-        group = self.sdk.GroupSyncWrite(self.port, self._ph, address, length)
         for servo_id, tick in goals.items():
             model = self._model(servo_id)
-            tick = int(tick)
-            if not model.min_tick <= tick <= model.max_tick:
-                raise ValueError(f"goal {tick} ticks for servo {servo_id} ({model.name}) outside "
+            if not model.min_tick <= int(tick) <= model.max_tick:
+                raise ValueError(f"goal {int(tick)} ticks for servo {servo_id} ({model.name}) outside "
                                  f"{model.min_tick}..{model.max_tick}")
-            group.addParam(servo_id, list(tick.to_bytes(length, model.byte_order)))
+        self.send_goal_ticks(goals)
+
+    def send_goal_ticks(self, goals: Mapping[int, int]) -> None:
+        """One goal sync write, its goals already checked (by the LimitGuard, whose limits lie inside the
+        servos' tick ranges): the 60 Hz path, on the bus's one GroupSyncWrite."""
+        self._require_open()
         if not goals:
             return
+        models = self.models
+        length = self._goal[1]
+        group = self._goal_group
+        try:
+            params = [(servo_id, list(int(tick).to_bytes(length, models[servo_id].byte_order)))
+                      for servo_id, tick in goals.items()]
+        except KeyError as exc:
+            raise self._unknown_id(exc.args[0]) from None
+        if list(group.data_dict) == [servo_id for servo_id, _ in params]:
+            for servo_id, data in params:
+                group.changeParam(servo_id, data)
+        else:
+            group.clearParam()
+            for servo_id, data in params:
+                group.addParam(servo_id, data)
         self._before_transaction()
         with self._port_guard():
             result = group.txPacket()
@@ -295,11 +318,13 @@ class SdkBus(Bus):
         pending = list(wanted)
         failed_id, result = pending[0], self.sdk.COMM_SUCCESS
         outcomes: dict[int, list[int]] = {}
+        group = self._read_group
         for _ in range(1 + self.retries):
             self._before_transaction()
-            group = self.sdk.GroupSyncRead(self.port, self._ph, address, length)
-            for servo_id in pending:
-                group.addParam(servo_id)
+            if list(group.data_dict) != pending:
+                group.clearParam()
+                for servo_id in pending:
+                    group.addParam(servo_id)
             with self._port_guard():
                 self._drop_stale_input()
                 result = group.txPacket()
@@ -346,13 +371,12 @@ class SdkBus(Bus):
     def _status_error(self, servo_id: int, error: int) -> ServoStatusError:
         model = self._model(servo_id)
         hardware = None
-        if self.family == "dynamixel" and self.protocol == 2.0 and error & V2_ALERT \
-                and model.name in HARDWARE_ERROR_STATUS:
+        address = hardware_error_address(model.name)
+        if self.family == "dynamixel" and self.protocol == 2.0 and error & dynamixel.V2_ALERT and address is not None:
             try:  # one attempt: the message is better with it, the stop does not depend on it
                 with self._port_guard(servo_id):
                     self._drop_stale_input()
-                    value, result, _ = self._ph.read1ByteTxRx(self.port, servo_id,
-                                                              HARDWARE_ERROR_STATUS[model.name][0])
+                    value, result, _ = self._ph.read1ByteTxRx(self.port, servo_id, address)
                 hardware = value if result == self.sdk.COMM_SUCCESS else None
             except BusError:
                 hardware = None
@@ -478,8 +502,10 @@ class SdkBus(Bus):
         try:
             return self.models[servo_id]
         except KeyError:
-            raise ValueError(f"servo id {servo_id} is not on bus {self.port_name} "
-                             f"(ids: {sorted(self.models)})") from None
+            raise self._unknown_id(servo_id) from None
+
+    def _unknown_id(self, servo_id: int) -> ValueError:
+        return ValueError(f"servo id {servo_id} is not on bus {self.port_name} (ids: {sorted(self.models)})")
 
     def _require_open(self) -> None:
         if not self._is_open:

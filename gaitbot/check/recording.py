@@ -48,17 +48,15 @@ from pathlib import Path
 
 import numpy as np
 
-from gaitbot.bus import wire
-from gaitbot.bus.log_decoder import LOG_FORMAT, LOG_VERSION, RecordedPacket, RecordingError, parse_packet
-from gaitbot.check import CheckReport, check_trajectory
-from gaitbot.recorded_settings import SettingWrite, describe_settings, setting_write
+from gaitbot.bus.log import BusLog, RecordedPacket, RecordingError, parse_packet, read_header, read_log
+from gaitbot.check.settings import SettingWrite, describe_settings, setting_write
+from gaitbot.check.trajectory import CheckReport, check_trajectory
 from gaitbot.robot.calibration import ticks_to_angles
-from gaitbot.robot.config import RobotConfig
-from gaitbot.robot.servo_models import servo_model
+from gaitbot.robot.config import RobotConfig, shipped_config_dirs, shipped_config_names
+from gaitbot.servos import wire
 
 MAX_GAP_PERIODS = 1.5
 BUS_KIND_ORDER = ("packet", "ids", "timing", "status", "file", "config")
-_HEADER_KEYS = ("backend", "protocol", "baudrate", "robot", "joints", "models")
 _HEX_SHOWN = 48  # hex characters of a packet quoted in a message
 
 
@@ -254,92 +252,21 @@ class _Logged:
     problem: str
 
 
-def read_log(path: str | Path, *, allow_partial_last_line: bool = False) -> tuple[dict, list[_Logged], list[BusIssue]]:
-    """Header, every packet line, and file-level warnings. Raises RecordingError (exit 2) for a file
-    that cannot be read as a bus log; bad bytes inside a packet are left for the checks."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise RecordingError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RecordingError(f"{path}: cannot read ({exc})") from None
-    lines = text.split("\n")
-    notes: list[BusIssue] = []
-    if lines and lines[-1] == "":
-        lines.pop()
-    elif lines and lines[-1].strip():
-        n = len(lines)
-        if not allow_partial_last_line:
-            raise RecordingError(f"{path}:{n}: truncated last line (no newline: the file was cut short, "
-                                 "e.g. by a crash while writing); pass --allow-partial to check the complete lines")
-        notes.append(BusIssue("file", "warning", n, float("nan"),
+def _packets(log: BusLog) -> tuple[list[_Logged], list[BusIssue]]:
+    """Every packet line of a log (gaitbot.bus.log, the format's reader) parsed, and file-level warnings."""
+    packets = []
+    for line in log.lines:
+        if line.data is None:
+            packets.append(_Logged(line.line_no, line.t_s, line.direction, line.hex, None, line.problem))
+            continue
+        parsed = parse_packet(RecordedPacket(line.line_no, line.t_s, line.direction, line.data), log.framing)
+        packets.append(_Logged(line.line_no, line.t_s, line.direction, line.hex, parsed,
+                               "" if parsed.checksum_ok else parsed.problem))
+    notes = []
+    if log.dropped_partial_line is not None:
+        notes.append(BusIssue("file", "warning", log.dropped_partial_line, packets[-1].t_s if packets else 0.0,
                               "truncated last line (no newline) ignored; checked the complete lines before it"))
-        lines.pop()
-    if not lines or not lines[0].strip():
-        raise RecordingError(f"{path}:1: empty file, no {LOG_FORMAT} header")
-    header = _header(path, lines[0])
-    framing = wire.framing_for(header["backend"], header["protocol"])
-    packets = [_packet(path, n, line, framing) for n, line in enumerate(lines[1:], start=2) if line.strip()]
-    if notes:
-        last_t = packets[-1].t_s if packets else 0.0
-        notes = [BusIssue(i.kind, i.severity, i.line_no, last_t, i.message) for i in notes]
-    return header, packets, notes
-
-
-def _header(path: Path, line: str) -> dict:
-    try:
-        header = json.loads(line)
-    except json.JSONDecodeError as exc:
-        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (line 1 is not JSON: {exc.msg})") from None
-    if not isinstance(header, dict) or header.get("format") != LOG_FORMAT:
-        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (the first line must be "
-                             f"{{\"format\": \"{LOG_FORMAT}\", ...}}; is the file a bus recording, complete from its start?)")
-    if header.get("version") != LOG_VERSION:
-        raise RecordingError(f"{path}:1: unsupported log version {header.get('version')!r} (reads {LOG_VERSION})")
-    missing = [k for k in _HEADER_KEYS if k not in header]
-    if missing:
-        raise RecordingError(f"{path}:1: header lacks {', '.join(missing)}")
-    joints, models = header["joints"], header["models"]
-    if not isinstance(joints, dict) or not isinstance(models, dict):
-        raise RecordingError(f"{path}:1: header joints and models must be objects")
-    try:
-        header["joints"] = {str(k): int(v) for k, v in joints.items()}
-        header["models"] = {int(k): str(v) for k, v in models.items()}
-        header["protocol"] = float(header["protocol"])
-        for name in header["models"].values():
-            servo_model(name)
-    except (TypeError, ValueError, KeyError) as exc:
-        raise RecordingError(f"{path}:1: bad header joints/models/protocol: {exc}") from None
-    if header["backend"] not in ("dynamixel", "feetech"):
-        raise RecordingError(f"{path}:1: unknown backend {header['backend']!r} (dynamixel or feetech)")
-    return header
-
-
-def _packet(path: Path, line_no: int, line: str, framing: str) -> _Logged:
-    try:
-        obj = json.loads(line)
-    except json.JSONDecodeError as exc:
-        raise RecordingError(f"{path}:{line_no}: bad JSON ({exc.msg}); not a bus recording line") from None
-    if not isinstance(obj, dict) or not all(k in obj for k in ("t", "dir", "hex")):
-        raise RecordingError(f"{path}:{line_no}: not a packet line (needs t, dir, hex)")
-    try:
-        t_s = float(obj["t"])
-    except (TypeError, ValueError):
-        raise RecordingError(f"{path}:{line_no}: t is not a number: {obj['t']!r}") from None
-    if not np.isfinite(t_s):
-        raise RecordingError(f"{path}:{line_no}: t is not a finite number: {obj['t']!r}")
-    direction, hex_text = obj["dir"], obj["hex"]
-    if direction not in ("tx", "rx"):
-        raise RecordingError(f"{path}:{line_no}: dir must be \"tx\" or \"rx\", got {direction!r}")
-    if not isinstance(hex_text, str):
-        raise RecordingError(f"{path}:{line_no}: hex must be a string")
-    try:
-        data = bytes.fromhex(hex_text)
-    except ValueError:
-        return _Logged(line_no, t_s, direction, hex_text, None, "bytes are not valid hex (corrupted line)")
-    parsed = parse_packet(RecordedPacket(line_no, t_s, direction, data), framing)
-    return _Logged(line_no, t_s, direction, hex_text, parsed, "" if parsed.checksum_ok else parsed.problem)
+    return packets, notes
 
 
 # ---------------------------------------------------------------------------------------------- robot
@@ -347,14 +274,12 @@ def _packet(path: Path, line_no: int, line: str, framing: str) -> _Logged:
 
 def robot_for_recording(path: str | Path, robot: str | None, load_robot) -> RobotConfig:
     """The config to check ``path`` against: ``robot`` if given, else the shipped config named in the
-    header. ``load_robot`` is ``gaitbot.session.load_robot`` (passed in: the check room does not
-    import the command wiring)."""
+    header. ``load_robot`` is ``gaitbot.app.options.load_robot`` (passed in: the check room does not
+    import the command line)."""
     if robot:
         return load_robot(robot)
-    header = _header_only(path)
+    header = read_header(path)
     name = str(header.get("robot", ""))
-    from gaitbot.robot.config import shipped_config_dirs, shipped_config_names
-
     if name in shipped_config_names():
         for directory in shipped_config_dirs():
             candidate = directory / f"{name}.toml"
@@ -362,20 +287,6 @@ def robot_for_recording(path: str | Path, robot: str | None, load_robot) -> Robo
                 return load_robot(str(candidate))
     raise RecordingError(f"{path}: recorded with robot {name!r}, which is not a shipped config "
                          f"({', '.join(shipped_config_names())}); give its config with --robot PATH")
-
-
-def _header_only(path: str | Path) -> dict:
-    path = Path(path)
-    try:
-        with open(path, encoding="utf-8") as f:
-            first = f.readline()
-    except FileNotFoundError:
-        raise RecordingError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RecordingError(f"{path}: cannot read ({exc})") from None
-    if not first.strip():
-        raise RecordingError(f"{path}:1: empty file, no {LOG_FORMAT} header")
-    return _header(path, first)
 
 
 def match_config(path: str | Path, header: dict, config: RobotConfig) -> list[BusIssue]:
@@ -418,7 +329,9 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
     Raises RecordingError (RecordingMismatch) for a file that cannot be checked: unreadable, no
     header, a config of another robot, or no goal frames at all.
     """
-    header, packets, issues = read_log(path, allow_partial_last_line=allow_partial_last_line)
+    log = read_log(path, allow_partial_last_line=allow_partial_last_line)
+    header = log.header
+    packets, issues = _packets(log)
     issues += match_config(path, header, config)
     names = {j.id: j.name for j in config.joints}
     column = {j.id: c for c, j in enumerate(config.joints)}

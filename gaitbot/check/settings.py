@@ -1,7 +1,7 @@
 """The settings a recorded run wrote to its servos (gains, the Feetech lock), for ``gaitbot check``.
 
 A session writes each servo's gain register before torque on (``[servo] full_torque_error_deg``,
-gaitbot.robot.servo_gains). Those WRITE packets are neither goals nor torque switches; the recording
+gaitbot.robot.gains). Those WRITE packets are neither goals nor torque switches; the recording
 check accepts them like any well-formed packet to a configured id and lists them here, named after
 the servo model's register where gaitbot knows it, so a reader can see what stiffness the robot ran at.
 """
@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from gaitbot.bus import wire
-from gaitbot.robot.servo_models import ServoModel
+from gaitbot.servos import wire
+from gaitbot.servos.models import ServoModel
 
 
 @dataclass(frozen=True)
@@ -30,13 +30,12 @@ class SettingWrite:
 def setting_write(line_no: int, t_s: float, packet, model: ServoModel) -> SettingWrite | None:
     """The setting a tx packet writes (None for anything else: goals, torque, reads, sync packets).
 
-    ``packet`` is a checksum-valid ParsedPacket (gaitbot.bus.log_decoder)."""
+    ``packet`` is a checksum-valid ParsedPacket (gaitbot.bus.log)."""
     if packet.instruction != wire.INST_WRITE or packet.address is None or not packet.data:
         return None
     address, length = packet.address, len(packet.data)
-    for start, size in ((model.addr_goal_position, model.len_goal_position), (model.addr_torque_enable, 1)):
-        if address < start + size and start < address + length:
-            return None
+    if model.command_register_touched(address, length) is not None:
+        return None
     value = int.from_bytes(packet.data, model.byte_order)
     return SettingWrite(line_no, t_s, packet.packet_id, address, length, value, _register_name(model, address))
 

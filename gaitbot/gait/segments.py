@@ -34,6 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gaitbot.errors import UserError
+
 from .blend import BoulicBlend
 from .boulic import toe_off_phase
 from .contact import ankle_in_body, grounded_ankle, heel_pinned_ankle, leg_pitch, lowest_sole_y
@@ -47,7 +49,7 @@ PINNED_MIN_KNEE_RAD = np.radians(10.0)  # the pinned rear foot keeps more, leavi
 CLEARANCE_WINDOW = (0.2, 0.8)  # share of each swing's duration where the clearance must hold
 
 
-class GaitGenerationError(ValueError):
+class GaitGenerationError(UserError, ValueError):
     """The requested motion cannot be generated for this leg (e.g. a foot out of the leg's reach)."""
 
 

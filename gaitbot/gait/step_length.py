@@ -16,12 +16,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gaitbot.errors import UserError
+
 from .blend import BoulicBlend
 from .boulic import REGION_A_MAX, TABLE2_CYCLE_S, pose_rad
 from .geometry import LegGeometry, foot_pitch, leg_points
 
 
-class StepLengthError(ValueError):
+class StepLengthError(UserError, ValueError):
     """A requested step length is negative, not finite, or beyond the reachable maximum."""
 
 

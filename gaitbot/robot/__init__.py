@@ -1,1 +1,2 @@
-"""The robot room: robot description from config, servo models, calibration and limits."""
+"""The robot room: a robot's config (one field-checked TOML file), its calibration (angles <-> ticks,
+built once per config), its servos' gains, and the walk settings the gait room takes from it."""

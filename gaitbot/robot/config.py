@@ -1,13 +1,13 @@
 """Robot description from a TOML file: geometry, gait settings, bus and joints, validated.
 
 Why so strict: a config error found on the bench means a servo driven into its end stop or a
-mirror-mounted knee bending backwards. Every value is checked when the file is loaded and the
-first problem is reported as ONE line naming the file, the field and what is allowed::
+mirror-mounted knee bending backwards. Every value is checked when the file is loaded (through
+gaitbot.fields, the one field-checked reader) and the first problem is reported as ONE line naming
+the file, the field and what is allowed::
 
     config/xl430-biped.toml: joints.knee_pitch_left.min_deg: 120.0 is above max_deg 110.0
 
-Unknown keys are errors too: they are usually typos (``max_velocity_dsp``) that would otherwise
-silently fall back to nothing.
+The file format is written down in docs/robot-config.md.
 
 Checks that need another room (whether the bus can carry ``gait.rate_hz`` frames at
 ``bus.baudrate``: ``gaitbot.bus.budget``) are passed in by the caller through ``extra_checks``,
@@ -18,44 +18,29 @@ from __future__ import annotations
 
 import difflib
 import math
-import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from functools import cached_property
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from gaitbot.fields import FieldError, Fields, kind, read_toml
 from gaitbot.gait.trajectory import WALKING_JOINTS
-from gaitbot.robot.calibration import angle_rad_to_ticks
-from gaitbot.robot.servo_gains import GainError, gain_for_error
-from gaitbot.robot.servo_models import SERVO_MODELS, ServoModel
-
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib  # type: ignore[no-redef]
+from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
+from gaitbot.robot.gains import GainError, gain_for_error
+from gaitbot.servos import BACKENDS, dynamixel, feetech, max_servo_id
+from gaitbot.servos.models import SERVO_MODELS, ServoModel
 
 DEFAULT_ROBOT = "xl430-biped"
-BACKENDS = ("dynamixel", "feetech")
-DYNAMIXEL_PROTOCOLS = (1.0, 2.0)
-FEETECH_PROTOCOL = 1.0
-# Highest usable id per backend; 254 is the broadcast id on both, Dynamixel reserves 253 too.
-MAX_SERVO_ID = {"dynamixel": 252, "feetech": 253}
 
 
-class ConfigError(ValueError):
+class ConfigError(FieldError):
     """A robot config is unusable. The message is one line: ``<file>: <field>: <what is wrong>``.
 
-    ``path``, ``field`` and ``reason`` hold the three parts for callers that want them apart.
     Other modules that check a loaded config (the bus budget) build theirs with ``ConfigError(path,
     field, reason)`` so every config complaint looks the same.
     """
-
-    def __init__(self, path: str | Path, field: str, reason: str) -> None:
-        self.path = str(path)
-        self.field = field
-        self.reason = " ".join(str(reason).split())  # one line, whatever the reason held
-        super().__init__(f"{self.path}: {field}: {self.reason}")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -99,7 +84,7 @@ class TerrainReach:
 @dataclass(frozen=True)
 class BusSettings:
     """The serial bus. ``protocol`` is the Dynamixel protocol version; Feetech buses always get 1.0,
-    the one (Dynamixel-1.0-shaped) protocol Feetech servos speak (servo_models lists them as (1.0,))."""
+    the one (Dynamixel-1.0-shaped) protocol Feetech servos speak (gaitbot.servos.feetech.PROTOCOLS)."""
 
     backend: str
     protocol: float
@@ -151,9 +136,9 @@ class ServoSettings:
 
     ``full_torque_error_deg`` is a real setting: the position error (degrees) at which every servo's
     position loop gives full output, smaller is stiffer. A session writes it to each servo's gain
-    register before torque goes on (gaitbot.robot.servo_gains); None leaves the factory gains alone.
+    register before torque goes on (gaitbot.robot.gains); None leaves the factory gains alone.
     ``stall_torque_nm`` (N m) and ``no_load_speed_rpm`` (rev/min) override the servo models' datasheet
-    figures (gaitbot.robot.servo_models) for the simulated robot only; None keeps them."""
+    figures (gaitbot.servos.models) for the simulated robot only; None keeps them."""
 
     stall_torque_nm: float | None = None
     no_load_speed_rpm: float | None = None
@@ -190,6 +175,11 @@ class RobotConfig:
     def ids(self) -> tuple[int, ...]:
         """Servo ids in joint order."""
         return tuple(j.id for j in self.joints)
+
+    @cached_property
+    def calibration(self) -> Calibration:
+        """Angles <-> ticks for every joint, built once per config."""
+        return Calibration.of(self.joints, len(WALKING_JOINTS))
 
     @property
     def models_by_id(self) -> dict[int, ServoModel]:
@@ -271,21 +261,7 @@ def load_robot_config(path: str | Path, *, extra_checks: Iterable[ConfigCheck] =
     ``gaitbot.bus.budget``'s check that the bus can carry ``gait.rate_hz`` frames per second.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise ConfigError(path, "file", f"cannot read ({reason})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        message = str(exc)
-        match = re.search(r"\(at line (\d+), column (\d+)\)", message)
-        where = f"line {match.group(1)}" if match else "file"
-        reason = re.sub(r"\s*\(at line \d+, column \d+\)", "", message)
-        if match:
-            reason += f" (column {match.group(2)})"
-        raise ConfigError(path, where, f"TOML syntax error: {reason}") from None
+    data = read_toml(path, ConfigError)
     config = _Reader(path).robot(data)
     for check in extra_checks:
         check(config)
@@ -304,67 +280,11 @@ _JOINT_KEYS = ("id", "model", "zero_tick", "direction", "min_deg", "max_deg", "m
                "max_acceleration_dps2", "hold_deg")
 
 
-class _Reader:
-    """Field-by-field reading with the field's dotted name at hand for the error message."""
+class _Reader(Fields):
+    """The robot config's sections, read field by field (gaitbot.fields)."""
 
     def __init__(self, path: Path) -> None:
-        self.path = path
-
-    def fail(self, field: str, reason: str) -> ConfigError:
-        return ConfigError(self.path, field, reason)
-
-    # -- generic pieces -----------------------------------------------------------------------
-
-    def table(self, parent: dict, key: str, field: str, allowed: tuple[str, ...]) -> dict:
-        if key not in parent:
-            raise self.fail(field, f"missing section [{field}]")
-        value = parent[key]
-        if not isinstance(value, dict):
-            raise self.fail(field, f"must be a table [{field}], got {_kind(value)}")
-        self.no_unknown_keys(value, field, allowed)
-        return value
-
-    def no_unknown_keys(self, table: dict, field: str, allowed: tuple[str, ...]) -> None:
-        for key in table:
-            if key not in allowed:
-                close = difflib.get_close_matches(key, allowed, n=1)
-                hint = f"did you mean {close[0]!r}? " if close else ""
-                prefix = f"{field}.{key}" if field else key
-                raise self.fail(prefix, f"unknown key ({hint}allowed: {', '.join(allowed)})")
-
-    def require(self, table: dict, key: str, field: str, what: str):
-        if key not in table:
-            raise self.fail(f"{field}.{key}", f"missing (expected {what})")
-        return table[key]
-
-    def number(self, table: dict, key: str, field: str, *, positive: bool = False,
-               non_negative: bool = False, default: float | None = None) -> float:
-        what = "a positive number" if positive else "a number >= 0" if non_negative else "a number"
-        if key not in table and default is not None:
-            return default
-        value = self.require(table, key, field, what)
-        name = f"{field}.{key}"
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self.fail(name, f"must be {what}, got {_kind(value)}")
-        if not math.isfinite(value):
-            raise self.fail(name, f"must be a finite number, got {value}")
-        if positive and value <= 0:
-            raise self.fail(name, f"must be a positive number, got {value}")
-        if non_negative and value < 0:
-            raise self.fail(name, f"must be >= 0, got {value}")
-        return float(value)
-
-    def integer(self, table: dict, key: str, field: str, what: str = "an integer"):
-        value = self.require(table, key, field, what)
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise self.fail(f"{field}.{key}", f"must be {what}, got {_kind(value)}")
-        return value
-
-    def string(self, table: dict, key: str, field: str, what: str = "a non-empty string") -> str:
-        value = self.require(table, key, field, what)
-        if not isinstance(value, str) or not value.strip():
-            raise self.fail(f"{field}.{key}", f"must be {what}, got {_kind(value)}")
-        return value
+        super().__init__(path, ConfigError)
 
     # -- sections -----------------------------------------------------------------------------
 
@@ -376,8 +296,8 @@ class _Reader:
         gait = self.gait(self.table(data, "gait", "gait", _GAIT_KEYS))
         bus = self.bus(self.table(data, "bus", "bus", _BUS_KEYS))
         joints = self.joints(data, bus)
-        mass = self.mass(self.optional_table(data, "mass", _MASS_KEYS))
-        servo = self.servo(self.optional_table(data, "servo", _SERVO_KEYS))
+        mass = self.mass(self.optional_table(data, "mass", "mass", _MASS_KEYS))
+        servo = self.servo(self.optional_table(data, "servo", "servo", _SERVO_KEYS))
         self.gains_settable(joints, servo)
         terrain = None
         if "terrain" in data:
@@ -385,10 +305,6 @@ class _Reader:
             terrain = TerrainReach(*(self.number(t, key, "terrain", non_negative=True) for key in _TERRAIN_KEYS))
         return RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
                            mass=mass, servo=servo, terrain=terrain)
-
-    def optional_table(self, data: dict, key: str, allowed: tuple[str, ...]) -> dict:
-        """An optional section: {} when absent, otherwise checked like a required one."""
-        return self.table(data, key, key, allowed) if key in data else {}
 
     def mass(self, t: dict) -> MassSettings:
         defaults = MassSettings()
@@ -439,20 +355,18 @@ class _Reader:
         backend = self.string(t, "backend", f, f"one of {', '.join(map(repr, BACKENDS))}")
         if backend not in BACKENDS:
             raise self.fail("bus.backend", f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
-        protocol = FEETECH_PROTOCOL
+        protocol = feetech.PROTOCOLS[0]
         if backend == "dynamixel":
-            allowed = " or ".join(str(p) for p in DYNAMIXEL_PROTOCOLS)
+            allowed = " or ".join(str(p) for p in dynamixel.PROTOCOLS)
             protocol = self.number(t, "protocol", f)
-            if protocol not in DYNAMIXEL_PROTOCOLS:
+            if protocol not in dynamixel.PROTOCOLS:
                 raise self.fail("bus.protocol", f"unknown Dynamixel protocol {protocol} (allowed: {allowed})")
         # Feetech servos speak one protocol; a protocol key there is accepted and ignored (always 1.0).
         port = self.string(t, "port", f, "a serial port name, e.g. '/dev/ttyUSB0' or 'COM3'")
         baudrate = self.integer(t, "baudrate", f, "a positive integer (bits per second)")
         if baudrate <= 0:
             raise self.fail("bus.baudrate", f"must be a positive integer (bits per second), got {baudrate}")
-        torque_off = t.get("torque_off_on_exit", False)
-        if not isinstance(torque_off, bool):
-            raise self.fail("bus.torque_off_on_exit", f"must be true or false, got {_kind(torque_off)}")
+        torque_off = self.boolean(t, "torque_off_on_exit", f, default=False)
         return BusSettings(backend=backend, protocol=protocol, port=port, baudrate=baudrate,
                            torque_off_on_exit=torque_off)
 
@@ -461,7 +375,7 @@ class _Reader:
             raise self.fail("joints", f"missing section (expected [joints.<name>] for {', '.join(WALKING_JOINTS)})")
         tables = data["joints"]
         if not isinstance(tables, dict):
-            raise self.fail("joints", f"must be tables [joints.<name>], got {_kind(tables)}")
+            raise self.fail("joints", f"must be tables [joints.<name>], got {kind(tables)}")
         for name in WALKING_JOINTS:
             if name not in tables:
                 others = [n for n in tables if n not in WALKING_JOINTS]
@@ -477,7 +391,7 @@ class _Reader:
     def joint(self, name: str, t: Any, bus: BusSettings) -> JointConfig:
         f = f"joints.{name}"
         if not isinstance(t, dict):
-            raise self.fail(f, f"must be a table [{f}], got {_kind(t)}")
+            raise self.fail(f, f"must be a table [{f}], got {kind(t)}")
         self.no_unknown_keys(t, f, _JOINT_KEYS)
         walking = name in WALKING_JOINTS
 
@@ -494,7 +408,7 @@ class _Reader:
             raise self.fail("bus.protocol", f"{model_name} ({f}) does not speak protocol {bus.protocol} "
                                             f"(it speaks {spoken})")
 
-        max_id = MAX_SERVO_ID[bus.backend]
+        max_id = max_servo_id(bus.backend, bus.protocol)
         servo_id = self.integer(t, "id", f, f"an integer servo id 0..{max_id}")
         if not 0 <= servo_id <= max_id:
             raise self.fail(f"{f}.id", f"{servo_id} is out of range for {bus.backend} (allowed: 0..{max_id})")
@@ -557,18 +471,3 @@ def _tick_range_deg(model: ServoModel, zero_tick: int, direction: int) -> tuple[
     """The angles (deg) at the two ends of the servo's tick range, for this zero_tick and direction."""
     return tuple(math.degrees((tick - zero_tick) / (direction * model.ticks_per_rad))
                  for tick in (model.min_tick, model.max_tick))  # type: ignore[return-value]
-
-
-def _kind(value: Any) -> str:
-    """A short description of a TOML value for error messages."""
-    if isinstance(value, bool):
-        return f"boolean {str(value).lower()}"
-    if isinstance(value, str):
-        return f"string {value!r}"
-    if isinstance(value, dict):
-        return "a table"
-    if isinstance(value, list):
-        return "an array"
-    if isinstance(value, (int, float)):
-        return f"number {value}"
-    return type(value).__name__

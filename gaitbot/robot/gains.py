@@ -3,7 +3,7 @@
 A position-controlled hobby servo is a proportional loop: its output grows with the position error
 and is full (stall torque) at some error; the smaller that error, the stiffer the joint. The robot
 config asks for that error in degrees, the same figure for every servo; each model's GainRegister
-(gaitbot.robot.servo_models, with its datasheet source) says which register sets it and how a register
+(gaitbot.servos.models, with its datasheet source) says which register sets it and how a register
 value maps to degrees. :func:`gain_for_error` is the one conversion from degrees to a register value,
 :func:`full_torque_error_deg` its inverse (what a value in the register gives: the simulated servo
 reads its stiffness from its control table with it).
@@ -21,7 +21,8 @@ import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
-from gaitbot.robot.servo_models import COMPLIANCE_SLOPE, SLOPE_STEPS, GainRegister, ServoModel
+from gaitbot.servos.models import COMPLIANCE_SLOPE, SLOPE_STEPS, GainRegister, ServoModel
+from gaitbot.servos.registers import RegisterWrite
 
 
 class RegisterValue(NamedTuple):
@@ -105,3 +106,16 @@ def gain_plan(config) -> tuple[tuple[GainSetting, tuple[int, ...]], ...]:
         ids.setdefault(joint.model.name, []).append(joint.id)
         models[joint.model.name] = joint.model
     return tuple((gain_for_error(models[name], error_deg), tuple(ids[name])) for name in ids)
+
+
+def gain_writes(config) -> tuple[RegisterWrite, ...]:
+    """What a session writes before torque on to give every servo ``[servo] full_torque_error_deg``
+    (nothing without it), one register write per servo model and register (checked at load)."""
+    return tuple(RegisterWrite(ids, w.address, w.length, w.value, w.name)
+                 for setting, ids in gain_plan(config) for w in setting.writes)
+
+
+def gain_notes(config) -> list[str]:
+    """One line per servo model for people: which gain is written and the stiffness it gives."""
+    return [f"servo stiffness: {setting.describe()}, written to ids {', '.join(map(str, sorted(ids)))} before "
+            f"torque on (in RAM: lasts until power-off)" for setting, ids in gain_plan(config)]

@@ -1,13 +1,17 @@
 """Servo models as data: resolution, range, protocol, byte order and control-table addresses.
 
 Kept as data (the LeRobot habit) so calibration, the bus backends and the emulator read one
-table. Each entry cites its datasheet / e-Manual control table.
+table. Addresses come from the vendors' control tables (gaitbot.servos.dynamixel / feetech); each
+entry cites its datasheet.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+from gaitbot.servos import dynamixel, feetech
+from gaitbot.servos.registers import ControlTable, overlaps
 
 #: Laws that turn a gain register value into the position error (deg) at which the loop gives full output.
 INVERSE_GAIN = "inverse"  # error_deg = error_deg_times_value / value (a P gain)
@@ -87,7 +91,7 @@ class ServoModel:
     len_velocity: int
     no_load_speed_rpm: float
     source: str
-    # Drive figures for the simulated robot (gaitbot.bus.sim), each with its source below:
+    # Drive figures for the simulated robot (gaitbot.sim), each with its source below:
     # stall torque in N m at the voltage of no_load_speed_rpm, and the position error at which the
     # servo's position loop, at its factory gains, asks for full torque (P-only loop: torque grows
     # linearly with the error up to the stall torque).
@@ -96,6 +100,24 @@ class ServoModel:
     # The register the session writes to set that stiffness (``[servo] full_torque_error_deg``); None
     # when gaitbot knows no register with a usable scale for the model.
     gain: GainRegister | None = None
+
+    def command_register_touched(self, address: int, length: int) -> tuple[int, str] | None:
+        """(register address, the bus call to use) when ``length`` bytes at ``address`` touch Goal Position
+        (write_goal_ticks) or Torque Enable (set_torque), which are commands, not settings; else None."""
+        for start, size, what in ((self.addr_goal_position, self.len_goal_position, "write_goal_ticks"),
+                                  (self.addr_torque_enable, 1, "set_torque")):
+            if overlaps(address, length, start, size):
+                return start, what
+        return None
+
+    @property
+    def control_table(self) -> ControlTable:
+        """The model's whole control table (register name -> address, size, factory value)."""
+        return (dynamixel if self.family == "dynamixel" else feetech).CONTROL_TABLES[self.name]
+
+    @property
+    def model_number(self) -> int:
+        return (dynamixel if self.family == "dynamixel" else feetech).MODEL_NUMBERS[self.name]
 
     @property
     def ticks_per_rad(self) -> float:
@@ -121,14 +143,16 @@ class ServoModel:
 # 177 pulses = 15.6 deg. (MuJoCo Menagerie's ROBOTIS OP3 model gives its XM430 joints kp 21.1 N m/rad
 # against a 4.1 N m stall torque: full torque at 11.1 deg, the same order.)
 _X_ERROR_DEG_TIMES_GAIN = 885 * 128 * 360 / 4096
-_X_FACTORY_GAIN = {"XM430-W350": 800, "XL430-W250": 640}
+_X_FACTORY_GAIN = {name: dynamixel.CONTROL_TABLES[name]["Position P Gain"].factory
+                   for name in ("XM430-W350", "XL430-W250")}
 
 
 def _x_gain(model_name: str) -> GainRegister:
     """Position P Gain(84) of one X series model (only the factory value differs)."""
+    register = dynamixel.CONTROL_TABLES[model_name]["Position P Gain"]
     return GainRegister(
-        name="Position P Gain", addresses=(84,), length=2, min_value=1, max_value=16383,
-        factory_value=_X_FACTORY_GAIN[model_name], law=INVERSE_GAIN, error_deg_times_value=_X_ERROR_DEG_TIMES_GAIN,
+        name="Position P Gain", addresses=(register.address,), length=register.size, min_value=1, max_value=16383,
+        factory_value=register.factory, law=INVERSE_GAIN, error_deg_times_value=_X_ERROR_DEG_TIMES_GAIN,
         source=f"ROBOTIS e-Manual {model_name} control table: Position P Gain(84), 2 bytes, RAM, 0..16383")
 
 
@@ -138,8 +162,10 @@ _XL430_GAIN, _XM430_GAIN = _x_gain("XL430-W250"), _x_gain("XM430-W350")
 # and "Compliance Slope"): a value acts as its step's representative 2, 4, 8, 16, 32, 64 or 128, and the
 # output falls off over that many units (300/1023 deg each) before the goal: full torque beyond
 # 32 x 0.293 = 9.4 deg at the factory slope.
+_AX_SLOPES = (dynamixel.AX_12A["CW Compliance Slope"], dynamixel.AX_12A["CCW Compliance Slope"])
 _AX_GAIN = GainRegister(
-    name="CW/CCW Compliance Slope", addresses=(28, 29), length=1, min_value=2, max_value=128, factory_value=32,
+    name="CW/CCW Compliance Slope", addresses=tuple(r.address for r in _AX_SLOPES), length=_AX_SLOPES[0].size,
+    min_value=2, max_value=128, factory_value=_AX_SLOPES[0].factory,
     law=COMPLIANCE_SLOPE, deg_per_unit=300 / 1023,
     source="ROBOTIS e-Manual AX-12A control table: CW/CCW Compliance Slope(28, 29), 1 byte each, RAM, "
            "steps 2..128")
@@ -151,11 +177,13 @@ _AX_GAIN = GainRegister(
 # address 55, "turn off EPROM saving"; unLockEprom writes 0). Lock is written to 1 first, so the gain
 # never outlives a power cycle whatever the servo was left at; that the new P takes effect at once,
 # without a restart, is taken from the memory table's RW access and not verified on hardware.
-_STS_FACTORY_P = 32
+_STS_P, _STS_LOCK = feetech.STS3215["P Coefficient"], feetech.STS3215["Lock"]
+_STS_FACTORY_P = _STS_P.factory
 _STS_GAIN = GainRegister(
-    name="P coefficient", addresses=(21,), length=1, min_value=1, max_value=255, factory_value=_STS_FACTORY_P,
+    name="P coefficient", addresses=(_STS_P.address,), length=_STS_P.size, min_value=1, max_value=255,
+    factory_value=_STS_FACTORY_P,
     law=INVERSE_GAIN, error_deg_times_value=_STS_FACTORY_P * _X_ERROR_DEG_TIMES_GAIN / _X_FACTORY_GAIN["XM430-W350"],
-    before=((55, 1, 1, "Lock"),), assumed=True,
+    before=((_STS_LOCK.address, _STS_LOCK.size, 1, "Lock"),), assumed=True,
     source="Feetech SMS/STS memory table: P coefficient(21), 1 byte, factory 32; Lock(55)")
 
 
@@ -165,20 +193,25 @@ _STS_GAIN = GainRegister(
 _X_FULL_TORQUE_ERROR_DEG = _X_ERROR_DEG_TIMES_GAIN / _X_FACTORY_GAIN["XM430-W350"]
 
 
+def _addresses(table: ControlTable, velocity: str) -> dict:
+    """The ServoModel fields that are control-table addresses, read from the vendor's table."""
+    torque, goal, present, speed = (table[name] for name in ("Torque Enable", "Goal Position", "Present Position",
+                                                             velocity))
+    return dict(addr_torque_enable=torque.address, addr_goal_position=goal.address, len_goal_position=goal.size,
+                addr_present_position=present.address, len_present_position=present.size,
+                addr_velocity=speed.address, len_velocity=speed.size)
+
+
 _X_SERIES = dict(
-    family="dynamixel", protocols=(1.0, 2.0), resolution_ticks=4096, range_deg=360.0, min_tick=0, max_tick=4095,
-    centre_tick=2048, wraps=True, byte_order="little", addr_torque_enable=64, addr_goal_position=116,
-    len_goal_position=4, addr_present_position=132, len_present_position=4, addr_velocity=112, len_velocity=4,
+    family="dynamixel", protocols=dynamixel.PROTOCOLS, resolution_ticks=4096, range_deg=360.0, min_tick=0,
+    max_tick=4095, centre_tick=2048, wraps=True, byte_order="little",
+    **_addresses(dynamixel.XL430_W250, "Profile Velocity"),
 )
 _AX_TABLE = dict(
     resolution_ticks=1024, range_deg=300.0, min_tick=0, max_tick=1023, centre_tick=512, wraps=False,
-    byte_order="little", addr_torque_enable=24, addr_goal_position=30, len_goal_position=2, addr_velocity=32,
-    len_velocity=2,
+    byte_order="little",
 )
-_FEETECH_TABLE = dict(
-    family="feetech", protocols=(1.0,), addr_torque_enable=40, addr_goal_position=42, len_goal_position=2,
-    addr_present_position=56, len_present_position=2, addr_velocity=46, len_velocity=2,
-)
+_FEETECH_TABLE = dict(family="feetech", protocols=feetech.PROTOCOLS, **_addresses(feetech.STS3215, "Goal Speed"))
 
 SERVO_MODELS: dict[str, ServoModel] = {
     m.name: m
@@ -204,20 +237,18 @@ SERVO_MODELS: dict[str, ServoModel] = {
         # joint mode 0..1023 over 300 deg; Torque Enable 24 (1 B), Goal Position 30 (2 B),
         # Moving Speed 32 (2 B), Present Position 37 (2 B). No-load speed 114 rev/min at 7.4 V.
         # Stall torque 0.39 N m at 7.4 V. Its P gain's scale is not documented: the X series figure is assumed.
-        ServoModel(name="XL-320", family="dynamixel", protocols=(2.0,), addr_present_position=37,
-                   len_present_position=2, no_load_speed_rpm=114.0, stall_torque_nm=0.39,
+        ServoModel(name="XL-320", family="dynamixel", protocols=(2.0,), no_load_speed_rpm=114.0, stall_torque_nm=0.39,
                    full_torque_error_deg=_X_FULL_TORQUE_ERROR_DEG,
                    source="ROBOTIS e-Manual XL-320 control table and specifications (114 rpm, 0.39 N m @ 7.4 V)",
-                   **_AX_TABLE),
+                   **_AX_TABLE, **_addresses(dynamixel.XL_320, "Moving Speed")),
         # Verified against emanual.robotis.com/docs/en/dxl/ax/ax-12a/: Protocol 1.0, model 12,
         # 0..1023 over 300 deg (0.29 deg/unit), Torque Enable 24, Goal Position 30 (2 B),
         # Moving Speed 32 (2 B), Present Position 36 (2 B). No-load speed 59 rev/min at 12 V.
         # Stall torque 1.5 N m at 12 V.
-        ServoModel(name="AX-12A", family="dynamixel", protocols=(1.0,), addr_present_position=36,
-                   len_present_position=2, no_load_speed_rpm=59.0, stall_torque_nm=1.5,
+        ServoModel(name="AX-12A", family="dynamixel", protocols=(1.0,), no_load_speed_rpm=59.0, stall_torque_nm=1.5,
                    full_torque_error_deg=_AX_GAIN.factory_error_deg, gain=_AX_GAIN,
                    source="ROBOTIS e-Manual AX-12A control table and specifications (59 rpm, 1.5 N m @ 12 V)",
-                   **_AX_TABLE),
+                   **_AX_TABLE, **_addresses(dynamixel.AX_12A, "Moving Speed")),
         # Verified against the Feetech SMS/STS memory table as transcribed in LeRobot
         # (lerobot/motors/feetech/tables.py, STS_SMS_SERIES_CONTROL_TABLE): model number 777 at
         # address 3; Torque Enable 40 (1 B), Goal Position 42 (2 B), Goal Speed 46 (2 B),

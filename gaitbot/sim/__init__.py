@@ -1,25 +1,29 @@
 """The simulated robot: a MuJoCo model of the robot config behind the same packets as a real bus.
 
-    make_sim_bus(config, clock, ...) -> (Bus, SimRobot)     gaitbot.bus.sim.sim_bus
+    make_sim_bus(config, robot, now, recorder=None) -> Bus     gaitbot.sim.port
 
-model.py builds the MJCF from the robot config, physics.py steps it on the streamer's clock,
-sim_bus.py is the serial port the real Dynamixel/Feetech packet code talks to, metrics.py says
-whether the walk really walked, video.py renders it. MuJoCo is an optional dependency (the
-``sim`` extra); :func:`import_mujoco` turns its absence into one line that says how to install it.
+model.py builds the MJCF from the robot config, physics.py steps it on the streamer's clock (a
+callable: this room does not import the stream room), port.py is the serial port the real
+Dynamixel/Feetech packet code talks to, metrics.py says whether the walk really walked, video.py
+renders it, walk.py joins them to the walker's plan; docs/simulation.md explains the model. MuJoCo
+is an optional dependency (the ``sim`` extra); :func:`import_mujoco` turns its absence into one line
+that says how to install it.
 """
 
 from __future__ import annotations
 
 import os
 
+from gaitbot.errors import UserError
+
 SIM_EXTRA_HINT = "install the sim extra: pip install 'gaitbot[sim]'"
 
 
-class SimUnavailable(ImportError):
+class SimUnavailable(UserError, ImportError):
     """An optional dependency of the simulation is missing; the message says how to install it."""
 
 
-class VideoError(ValueError):
+class VideoError(UserError, ValueError):
     """A video cannot be made (a file name we cannot write, or no offscreen rendering): one line."""
 
 

@@ -42,8 +42,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from gaitbot.bus.sim.model import SIDES
-from gaitbot.bus.sim.physics import SimRobot
+from gaitbot.sim.model import SIDES
+from gaitbot.sim.physics import SimRobot
 
 FALL_HEIGHT_SHARE = 0.5
 FALL_PITCH_DEG = 45.0

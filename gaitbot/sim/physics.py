@@ -15,8 +15,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from gaitbot.bus.sim import import_mujoco
-from gaitbot.bus.sim.model import SIDES, build_mjcf, joint_drives, substeps_per_frame
+from gaitbot.sim import import_mujoco
+from gaitbot.sim.model import SIDES, build_mjcf, joint_drives, substeps_per_frame
 from gaitbot.robot.config import RobotConfig
 
 

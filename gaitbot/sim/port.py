@@ -10,7 +10,7 @@ servos would) with physics behind the control tables instead of ideal servos:
   calibration, the inverse of what the streamer did);
 * a torque-enable write switches the joint's servo on or off;
 * a write to the model's gain register (Position P Gain, Compliance Slope, P coefficient) sets the
-  joint's stiffness from the register's bytes (GainRegister.full_torque_error_deg, gaitbot.robot.servo_models); the
+  joint's stiffness from the register's bytes (GainRegister.full_torque_error_deg, gaitbot.servos.models); the
   table starts with the factory value, so a session that writes no gain walks at factory stiffness;
 * a present-position read answers the simulated joint angle (angle -> ticks by the calibration).
 
@@ -21,25 +21,27 @@ servos. Everything else (pings, checksums, status packets, the recorder) is the 
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from gaitbot.bus.base import Bus
-from gaitbot.bus.factory import BACKENDS
+from gaitbot.bus.factory import bus_class
+from gaitbot.bus.log import BusRecorder
 from gaitbot.bus.mock import MockPort
-from gaitbot.bus.recording import BusRecorder
-from gaitbot.bus.sim.physics import SimRobot
-from gaitbot.clock import Clock
 from gaitbot.robot.calibration import angle_rad_to_ticks, ticks_to_angle_rad
 from gaitbot.robot.config import RobotConfig
+from gaitbot.servos.registers import overlaps
+from gaitbot.sim.physics import SimRobot
 
 
 class SimPort(MockPort):
-    """A MockPort whose walking servos are ``robot``'s joints, on ``clock``'s time."""
+    """A MockPort whose walking servos are ``robot``'s joints, on the time ``now()`` tells (seconds)."""
 
-    def __init__(self, config: RobotConfig, robot: SimRobot, clock: Clock, port_name: str = "sim") -> None:
+    def __init__(self, config: RobotConfig, robot: SimRobot, now: Callable[[], float], port_name: str = "sim") -> None:
         super().__init__(config.bus.backend, config.bus.protocol, config.models_by_id, port_name=port_name)
         self.robot = robot
-        self.clock = clock
+        self.now = now
         walking = config.walking_joints
         self.joint_of = {j.id: i for i, j in enumerate(walking)}
         self._ids = [j.id for j in walking]
@@ -49,7 +51,7 @@ class SimPort(MockPort):
         self._tick_range = (np.array([j.model.min_tick for j in walking]), np.array([j.model.max_tick for j in walking]))
 
     def writePort(self, packet) -> int:  # noqa: N802 (SDK name)
-        self.robot.advance_to(self.clock.now())
+        self.robot.advance_to(self.now())
         return super().writePort(packet)
 
     def _read(self, frame) -> None:
@@ -77,29 +79,27 @@ class SimPort(MockPort):
             return
         table, model = self.tables[servo_id], self.models[servo_id]
         table[address:address + len(data)] = data
-        if _overlaps(address, len(data), model.addr_goal_position, model.len_goal_position):
+        if overlaps(address, len(data), model.addr_goal_position, model.len_goal_position):
             start = model.addr_goal_position
             ticks = int.from_bytes(table[start:start + model.len_goal_position], model.byte_order)
             self.robot.set_goal(joint, float(ticks_to_angle_rad(ticks, *self._calibration[servo_id])))
-        if _overlaps(address, len(data), model.addr_torque_enable, 1):
+        if overlaps(address, len(data), model.addr_torque_enable, 1):
             self.robot.set_torque(joint, bool(table[model.addr_torque_enable]))
         gain = model.gain
-        if gain is not None and any(_overlaps(address, len(data), a, gain.length) for a in gain.addresses):
+        if gain is not None and any(overlaps(address, len(data), a, gain.length) for a in gain.addresses):
             # One stiffness per joint in a planar model: the softer of the registers (AX: CW and CCW slope).
             values = [int.from_bytes(table[a:a + gain.length], model.byte_order) for a in gain.addresses]
             self.robot.set_full_torque_error(joint, max(gain.full_torque_error_deg(v) for v in values))
 
 
-def _overlaps(start: int, length: int, field_start: int, field_length: int) -> bool:
-    return start < field_start + field_length and field_start < start + length
-
-
-def make_sim_bus(config: RobotConfig, robot: SimRobot, clock: Clock, recorder: BusRecorder | None = None) -> Bus:
-    """The robot's own bus class (Dynamixel or Feetech, with its SDK) on a SimPort.
+def make_sim_bus(config: RobotConfig, robot: SimRobot, now: Callable[[], float],
+                 recorder: BusRecorder | None = None) -> Bus:
+    """The robot's own bus class (Dynamixel or Feetech, with its SDK) on a SimPort whose physics follows
+    ``now()`` (the streamer's clock, e.g. ``VirtualClock().now``).
 
     Like a dry run, but the servos are ``robot``'s joints; the bus is not opened here."""
-    cls = BACKENDS[config.bus.backend]
-    handler = SimPort(config, robot, clock)
+    cls = bus_class(config.bus.backend)
+    handler = SimPort(config, robot, now)
     if recorder is not None:
         handler = recorder.wrap(handler, backend=config.bus.backend, protocol=config.bus.protocol,
                                 baudrate=config.bus.baudrate, models=config.models_by_id)

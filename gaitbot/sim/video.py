@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gaitbot.bus.sim import SIM_EXTRA_HINT, SimUnavailable, VideoError
-from gaitbot.bus.sim.physics import SimRobot
+from gaitbot.sim import SIM_EXTRA_HINT, SimUnavailable, VideoError
+from gaitbot.sim.physics import SimRobot
 
 FORMATS = {".gif": 20.0, ".mp4": 30.0}  # frames per second of each format
 SIZE = {".gif": (480, 320), ".mp4": (640, 352)}  # width, height (MP4: multiples of 16)

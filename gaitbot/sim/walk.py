@@ -1,7 +1,7 @@
-"""``gaitbot walk --sim``: the walk on the simulated robot, and what the plan promised it.
+"""A walk on the simulated robot, and what the plan promised it (``gaitbot walk --sim``).
 
-Sits on top, like commands.py: the simulation (gaitbot.bus.sim) never imports the gait room, so
-the planned distance, the swing windows and the footholds are taken from the walker here and
+The physics, the port and the meter (model.py, physics.py, port.py, metrics.py) know nothing of the
+gait: the planned distance, the swing windows and the footholds are taken from the walker here and
 handed down as a WalkPlan. The walk itself runs exactly as ``gaitbot walk`` runs it (preflight,
 LimitGuard, walk_session, --record); only the bus is the simulated robot's and the clock virtual.
 """
@@ -11,42 +11,15 @@ from __future__ import annotations
 import json
 import sys
 
+from collections.abc import Callable
+
 from gaitbot.bus.base import Bus
-from gaitbot.bus.recording import BusRecorder
-from gaitbot.bus.sim import import_mujoco
-from gaitbot.bus.sim.metrics import SimReport, SwingWindow, WalkMeter, WalkPlan
-from gaitbot.clock import Clock
+from gaitbot.bus.log import BusRecorder
 from gaitbot.gait.segments import CLEARANCE_WINDOW
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.gait.walker import OnlineWalker
 from gaitbot.robot.config import RobotConfig
-from gaitbot.session import UsageError
-
-
-def check_sim_arguments(args) -> None:
-    """Refuse what a simulated walk cannot honour, and a missing MuJoCo, before any work is done."""
-    sim = getattr(args, "sim", False)
-    if not sim:
-        for flag in ("free_pitch", "video", "json"):
-            if getattr(args, flag, None):
-                raise UsageError(f"--{flag.replace('_', '-')}: only with --sim (a simulated walk)")
-        return
-    refused = {"dry_run": "give --sim or --dry-run, not both",
-               "port": "a simulated walk has no serial port",
-               "realtime": "a simulated walk runs on the simulated clock, as fast as the CPU allows",
-               "terrain": "the simulated floor is flat; terrain courses are not simulated yet",
-               "reply_timeout_ms": "a simulated walk has no serial port",
-               "trajectory": "the measurements need the walker's plan (swing times, footholds): give --steps or --distance",
-               **{leg: "the simulated robot is built from the robot config: give the leg in a config file"
-                  for leg in ("thigh", "shank", "foot")}}
-    for flag, why in refused.items():
-        if getattr(args, flag, None):
-            raise UsageError(f"--{flag.replace('_', '-')}: {why}")
-    import_mujoco()
-    if getattr(args, "video", None):
-        from gaitbot.bus.sim.video import check_video_path
-
-        check_video_path(args.video)
+from gaitbot.sim.metrics import SimReport, SwingWindow, WalkMeter, WalkPlan
 
 
 def swing_windows(walker: OnlineWalker) -> tuple[SwingWindow, ...]:
@@ -76,7 +49,7 @@ class SimWalk:
 
     def __init__(self, config: RobotConfig, rate_hz: float, plan: WalkPlan, free_pitch: bool = False,
                  video: str | None = None) -> None:
-        from gaitbot.bus.sim.physics import SimRobot
+        from gaitbot.sim.physics import SimRobot
 
         self.config = config
         self.plan = plan
@@ -85,15 +58,16 @@ class SimWalk:
         self.robot.observers.append(self.meter)
         self.video = None
         if video:
-            from gaitbot.bus.sim.video import VideoRecorder
+            from gaitbot.sim.video import VideoRecorder
 
             self.video = VideoRecorder(self.robot, video, plan.footholds)
             self.robot.observers.append(self.video)
 
-    def make_bus(self, clock: Clock, recorder: BusRecorder | None) -> Bus:
-        from gaitbot.bus.sim.sim_bus import make_sim_bus
+    def make_bus(self, now: Callable[[], float], recorder: BusRecorder | None) -> Bus:
+        """The robot's bus on the simulated chain, its physics following ``now()`` (the session's clock)."""
+        from gaitbot.sim.port import make_sim_bus
 
-        return make_sim_bus(self.config, self.robot, clock, recorder)
+        return make_sim_bus(self.config, self.robot, now, recorder)
 
     def report(self) -> SimReport:
         return self.meter.report(self.plan, self.robot.free_pitch)

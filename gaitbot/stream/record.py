@@ -5,10 +5,10 @@ room's vocabulary); what a sample becomes (angles, a root, a CSV row) is the ``s
 (gaitbot/record_command.py), so data still flows one way inside each room.
 
 Sequence (:func:`record_session`): open the bus -> ping every servo and read where they are
-(:func:`gaitbot.stream.prepare`; a missing servo stops here, nothing written) -> ask
+(:func:`gaitbot.stream.session.prepare`; a missing servo stops here, nothing written) -> ask
 ``confirm(n)`` (a refusal ends here: nothing sent, torque as it was, no file) -> ``sink.open()``
 -> torque off on every servo -> read every servo's present position (sync read where the
-protocol has one) on the absolute-deadline grid of the streamer (:func:`gaitbot.stream.paced_deadlines`:
+protocol has one) on the absolute-deadline grid of the streamer (:func:`gaitbot.stream.pacing.paced_deadlines`:
 sample k due at ``k * period``, never re-anchored, never skipped, never in a burst) and hand each
 sample to ``sink.add(t_s, ticks)`` with ``t_s = k * period`` -> end.
 
@@ -41,9 +41,10 @@ from typing import Protocol
 import numpy as np
 
 from gaitbot.bus.base import Bus, BusError, RegisterWrite
-from gaitbot.clock import Clock, MonotonicClock
-from gaitbot.stream import (EXIT_CODES, LATE_THRESHOLD_S, Terminated, paced_deadlines, prepare,
-                            sigterm_raises_terminated, write_settings)
+from gaitbot.stream.clock import Clock, MonotonicClock
+from gaitbot.stream.pacing import LATE_THRESHOLD_S, paced_deadlines
+from gaitbot.stream.session import EXIT_CODES, prepare, write_settings
+from gaitbot.stream.signals import Terminated, sigterm_raises_terminated
 
 #: Exit status of each outcome: a stopped recording (Ctrl-C) is a normal end.
 RECORD_EXIT_CODES = {"declined": 0, "completed": 0, "stopped": 0, "terminated": EXIT_CODES["terminated"],

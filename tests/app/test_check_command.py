@@ -23,7 +23,7 @@ COLUMNS = ["t_s", "hip_pitch_left_deg", "knee_pitch_left_deg", "ankle_pitch_left
 
 @pytest.fixture(scope="module")
 def walks(tmp_path_factory):
-    from gaitbot.cli import main
+    from gaitbot.app.cli import main
 
     folder = tmp_path_factory.mktemp("walks")
     out = {}
@@ -216,18 +216,18 @@ def test_tool_script_same_exit_codes(tmp_path, walks):
 
 
 def test_console_command_in_a_subprocess(tmp_path, walks):
-    """python -m gaitbot.cli check, as a user runs it: one line on stderr, exit 2, no traceback."""
+    """python -m gaitbot.app.cli check, as a user runs it: one line on stderr, exit 2, no traceback."""
     path = tmp_path / "x.jsonl"
     path.write_text('{"t": 0.0, "dir": "tx", "hex": "ffff"}\n')
-    run = subprocess.run([sys.executable, "-m", "gaitbot.cli", "check", str(path)], capture_output=True, text=True)
+    run = subprocess.run([sys.executable, "-m", "gaitbot.app.cli", "check", str(path)], capture_output=True, text=True)
     assert run.returncode == 2 and "Traceback" not in run.stderr and "header" in run.stderr
-    run = subprocess.run([sys.executable, "-m", "gaitbot.cli", "check", str(walks["ax12a-biped"]),
+    run = subprocess.run([sys.executable, "-m", "gaitbot.app.cli", "check", str(walks["ax12a-biped"]),
                           "--robot", "ax12a-biped"], capture_output=True, text=True)
     assert run.returncode == 0
 
 
 def test_fast_csv_path_reads_what_trajectory_load_reads(walks):
-    from gaitbot.check_command import _load_trajectory
+    from gaitbot.gait.trajectory import load_fast as _load_trajectory
     from gaitbot.gait.trajectory import Trajectory
 
     fast, slow = _load_trajectory(walks["sts3215-biped"]), Trajectory.load(walks["sts3215-biped"])

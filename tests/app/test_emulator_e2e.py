@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gaitbot.bus.log_decoder import decode_goal_frames
+from gaitbot.bus.log import decode_goal_frames
 from gaitbot.robot.config import load_robot_config
 
 from test_emulator import se  # noqa: E402 - the emulator module, loaded from tools/
@@ -46,7 +46,7 @@ def scs_config(tmp_path: Path) -> Path:
 
 
 def gaitbot(*args: str, timeout: float = WALK_TIMEOUT_S) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "gaitbot.cli", *args], capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "gaitbot.app.cli", *args], capture_output=True, text=True,
                           timeout=timeout, stdin=subprocess.DEVNULL, cwd=ROOT)
 
 

@@ -10,11 +10,11 @@ import json
 import numpy as np
 import pytest
 
-from gaitbot.cli import main
+from gaitbot.app.cli import main
 from gaitbot.gait import Trajectory
 from gaitbot.gait.step_length import boulic_step_length
 from gaitbot.robot.config import load_robot_config, resolve_config
-from gaitbot.robot.gait_setup import leg_geometry
+from gaitbot.robot.walk_settings import leg_geometry
 
 HEADER = ("t_s,hip_pitch_left_deg,knee_pitch_left_deg,ankle_pitch_left_deg,"
           "hip_pitch_right_deg,knee_pitch_right_deg,ankle_pitch_right_deg,root_x_m,root_y_m")

@@ -23,16 +23,16 @@ import numpy as np
 import pytest
 
 from gaitbot.bus.factory import make_bus
-from gaitbot.cli import main
-from gaitbot.clock import VirtualClock
+from gaitbot.app.cli import main
+from gaitbot.stream.clock import VirtualClock
 from gaitbot.gait import generate_walk
 from gaitbot.gait.eigen import EigenGaitModel
 from gaitbot.gait.trajectory import Trajectory
-from gaitbot.record import record_session
-from gaitbot.record_command import TrajectorySink
+from gaitbot.stream.record import record_session
+from gaitbot.app.record import TrajectorySink
 from gaitbot.robot.calibration import angles_to_ticks
-from gaitbot.robot.gait_setup import leg_geometry, walk_settings
-from gaitbot.session import load_robot
+from gaitbot.robot.walk_settings import leg_geometry, walk_settings
+from gaitbot.app.options import load_robot
 
 from test_emulator import se  # noqa: E402 - the emulator module, loaded from tools/
 
@@ -126,7 +126,7 @@ def test_other_protocols_read_the_hand_to_one_tick(tmp_path, robot):
 # ---- the command line, in real time ------------------------------------------------------------
 
 def start_record(config_name: str, port: str, out: Path, *extra: str) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-m", "gaitbot.cli", "record", "--robot", config_name, "--port", port,
+    return subprocess.Popen([sys.executable, "-m", "gaitbot.app.cli", "record", "--robot", config_name, "--port", port,
                              "--yes", "--reply-timeout-ms", str(REPLY_TIMEOUT_MS), "-o", str(out), *extra],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
                             stdin=subprocess.DEVNULL)

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gaitbot.cli import main
+from gaitbot.app.cli import main
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.config import load_robot_config
 

@@ -18,13 +18,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gaitbot.bus.log_decoder import decode_goal_frames, read_recording
+from gaitbot.bus.log import decode_goal_frames, read_recording
 
 STAND_TICKS = 2048  # xl430-biped: every joint's zero_tick, the standing pose
 
 
 def start_walk(record: Path) -> subprocess.Popen:
-    cmd = [sys.executable, "-m", "gaitbot.cli", "walk", "--dry-run", "--realtime", "--distance", "1.0",
+    cmd = [sys.executable, "-m", "gaitbot.app.cli", "walk", "--dry-run", "--realtime", "--distance", "1.0",
            "--record", str(record)]
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 

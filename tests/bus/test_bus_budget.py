@@ -3,7 +3,7 @@
 import pytest
 
 from gaitbot.bus.budget import check_rate, frame_budget, max_rate_hz
-from gaitbot.robot.servo_models import SERVO_MODELS
+from gaitbot.servos.models import SERVO_MODELS
 
 X = SERVO_MODELS["XL430-W250"]
 

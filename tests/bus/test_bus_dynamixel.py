@@ -7,7 +7,7 @@ import dynamixel_sdk
 from gaitbot.bus import PortError, ServoTimeout
 from gaitbot.bus.dynamixel import DynamixelBus, StuffingProtocol2PacketHandler
 from gaitbot.bus.mock import MockPort
-from gaitbot.robot.servo_models import SERVO_MODELS
+from gaitbot.servos.models import SERVO_MODELS
 
 XM = SERVO_MODELS["XM430-W350"]  # same X-series layout as the XM430-W210 used in the e-Manual examples
 AX = SERVO_MODELS["AX-12A"]

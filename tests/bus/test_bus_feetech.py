@@ -6,7 +6,7 @@ from scservo_sdk import scservo_def
 
 from gaitbot.bus.feetech import FeetechBus
 from gaitbot.bus.mock import MockPort
-from gaitbot.robot.servo_models import SERVO_MODELS
+from gaitbot.servos.models import SERVO_MODELS
 
 STS = SERVO_MODELS["STS3215"]
 SCS = SERVO_MODELS["SCS0009"]

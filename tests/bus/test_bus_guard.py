@@ -7,10 +7,10 @@ import pytest
 
 from gaitbot.bus.factory import make_mock_bus
 from gaitbot.bus.guard import GoalOutsideLimits, LimitGuard
-from gaitbot.clock import VirtualClock
+from gaitbot.stream.clock import VirtualClock
 from gaitbot.robot.calibration import tick_limits
 from gaitbot.robot.config import load_robot_config, resolve_config
-from gaitbot.robot.servo_models import servo_model
+from gaitbot.servos.models import servo_model
 from gaitbot.stream import walk_session
 
 XL430 = servo_model("XL430-W250")

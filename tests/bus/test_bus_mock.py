@@ -10,7 +10,7 @@ from gaitbot.bus import make_bus, make_mock_bus
 from gaitbot.bus.dynamixel import DynamixelBus
 from gaitbot.bus.feetech import FeetechBus
 from gaitbot.bus.mock import MockPort
-from gaitbot.robot.servo_models import SERVO_MODELS
+from gaitbot.servos.models import SERVO_MODELS
 
 CASES = [("dynamixel", 2.0, "XL430-W250"), ("dynamixel", 1.0, "XM430-W350"), ("dynamixel", 2.0, "XL-320"),
          ("dynamixel", 1.0, "AX-12A"), ("feetech", 1.0, "STS3215"), ("feetech", 1.0, "SCS0009")]
@@ -74,7 +74,7 @@ def test_reply_timeout_option_replaces_the_sdk_timeout():
     """--reply-timeout-ms: the SDK's timeout is packet bytes at the baud rate + 2 x 16 ms + 2 ms;
     with the option it is packet bytes at the baud rate + the given milliseconds."""
     from gaitbot.bus.factory import make_bus
-    from gaitbot.robot.servo_models import servo_model
+    from gaitbot.servos.models import servo_model
 
     model = servo_model("XL430-W250")
     bus = make_bus("dynamixel", 2.0, "/dev/null-not-opened", 1_000_000, {1: model}, dry_run=False,

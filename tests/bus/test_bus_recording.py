@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from gaitbot.bus import make_bus
-from gaitbot.bus.recording import (BusRecorder, RecordingError, decode_goal_frames, parse_recording,
+from gaitbot.bus.log import (BusRecorder, RecordingError, decode_goal_frames, parse_recording,
                                    read_recording)
-from gaitbot.robot.servo_models import SERVO_MODELS
+from gaitbot.servos.models import SERVO_MODELS
 
 JOINTS = {"hip_pitch_left": 2, "hip_pitch_right": 1}  # header order differs from id order on purpose
 

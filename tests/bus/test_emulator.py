@@ -16,9 +16,9 @@ from pathlib import Path
 
 import pytest
 
-from gaitbot.bus import wire
-from gaitbot.bus.log_decoder import decode_goal_frames
-from gaitbot.robot.servo_models import servo_model
+from gaitbot.servos import wire
+from gaitbot.bus.log import decode_goal_frames
+from gaitbot.servos.models import servo_model
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -262,7 +262,7 @@ def test_a_hand_with_a_rate_follows_time_from_the_torque_off():
 def test_hand_from_a_trajectory_file_on_the_command_line(tmp_path):
     from gaitbot.gait import generate_walk
     from gaitbot.robot.config import load_robot_config, resolve_config
-    from gaitbot.robot.gait_setup import leg_geometry, walk_settings
+    from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 
     robot = load_robot_config(resolve_config("xl430-biped"))
     walk = generate_walk(leg_geometry(robot), [0.05, 0.05], walk_settings(robot))

@@ -13,9 +13,9 @@ import re
 import numpy as np
 import pytest
 
-from gaitbot.check_recording import (MAX_GAP_PERIODS, BusIssue, _frame_timing, _motion_samples, check_recording,
+from gaitbot.check.recording import (MAX_GAP_PERIODS, BusIssue, _frame_timing, _motion_samples, check_recording,
                                      match_config, read_log)
-from gaitbot.bus.log_decoder import RecordingError
+from gaitbot.bus.log import RecordingError
 from test_check_support import (PERIOD_S, ROBOTS, build_sync_write, config, goal_layout, goal_line_indices,
                                 goal_row_near, read_lines, run_cli, split_sync_write, write_lines)
 
@@ -23,7 +23,7 @@ from test_check_support import (PERIOD_S, ROBOTS, build_sync_write, config, goal
 @pytest.fixture(scope="module")
 def recordings(tmp_path_factory):
     """One clean dry-run recording per shipped robot, made through the real CLI."""
-    from gaitbot.cli import main
+    from gaitbot.app.cli import main
 
     out = {}
     folder = tmp_path_factory.mktemp("recordings")
@@ -135,7 +135,7 @@ def test_missing_id_in_one_frame_is_named(capsys, tmp_path, recordings, robot):
 
 
 def test_unknown_id_in_a_frame_and_in_a_ping(capsys, tmp_path, recordings):
-    from gaitbot.bus import wire
+    from gaitbot.servos import wire
 
     rows, path = edited(tmp_path, recordings, "sts3215-biped")
     header = rows[0]
@@ -331,7 +331,7 @@ def test_motion_samples_fill_missing_joints_and_supersede_same_time():
 
 
 def test_status_error_is_a_warning(tmp_path, recordings):
-    from gaitbot.bus import wire
+    from gaitbot.servos import wire
 
     rows = read_lines(recordings["ax12a-biped"])
     k = next(i for i, r in enumerate(rows[1:], start=1) if r["dir"] == "rx")

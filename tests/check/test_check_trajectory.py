@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pytest
 
-from gaitbot.check import check_trajectory, trajectory_angles_deg
+from gaitbot.check.trajectory import check_trajectory, trajectory_angles_deg
 from gaitbot.robot.config import load_robot_config, resolve_config
 
 RATE_HZ = 60.0

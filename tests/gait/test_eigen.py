@@ -12,7 +12,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from gaitbot.cli import main
+from gaitbot.app.cli import main
 from gaitbot.gait import generate_walk
 from gaitbot.gait.eigen import (FitOptions, cycles_from_trajectory, detect_heel_strikes, fit_model, synthesize_walk,
                                 walk_label)
@@ -23,8 +23,8 @@ from gaitbot.gait.eigen.pose import pose_pca
 from gaitbot.gait.footfall import swing_clearances
 from gaitbot.gait.eigen.synth import root_from_contact
 from gaitbot.gait.trajectory import Trajectory
-from gaitbot.robot.gait_setup import leg_geometry, walk_settings
-from gaitbot.session import load_robot
+from gaitbot.robot.walk_settings import leg_geometry, walk_settings
+from gaitbot.app.options import load_robot
 
 CFG = load_robot("xl430-biped")
 LEG, SETTINGS = leg_geometry(CFG), walk_settings(CFG)
@@ -498,7 +498,7 @@ def test_walk_refuses_a_trajectory_file_not_sampled_evenly(tmp_path, capsys):
 
 def test_plot_finds_the_heel_strikes_eigen_fit_finds(tmp_path):
     """A CSV carries no heel strikes: plot and eigen fit detect them with the same rule (footfall.py)."""
-    from gaitbot.plot import _detected_heel_strikes, _foot_heights
+    from gaitbot.plot.figures import _detected_heel_strikes, _foot_heights
 
     tr = walk(0.06)
     csv = tmp_path / "w.csv"

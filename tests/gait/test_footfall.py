@@ -12,8 +12,8 @@ import pytest
 from gaitbot.gait import generate_walk
 from gaitbot.gait.footfall import ContactRoot, foot_heights_in_body, root_from_contact, swing_clearances
 from gaitbot.gait.geometry import leg_points
-from gaitbot.robot.gait_setup import leg_geometry, walk_settings
-from gaitbot.session import load_robot
+from gaitbot.robot.walk_settings import leg_geometry, walk_settings
+from gaitbot.app.options import load_robot
 
 CFG = load_robot("xl430-biped")
 LEG, SETTINGS = leg_geometry(CFG), walk_settings(CFG)

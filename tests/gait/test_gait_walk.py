@@ -24,7 +24,7 @@ from gaitbot.gait import (TABLE1_LEG, LegGeometry, WalkSettings, generate_walk, 
                           steps_for_distance)
 from gaitbot.gait.walker import plan_walk, trajectory_of
 from gaitbot.robot.config import load_robot_config
-from gaitbot.robot.gait_setup import leg_geometry, walk_settings
+from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 
 CONFIG_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "config")
 CONFIG_FILES = sorted(glob.glob(os.path.join(CONFIG_DIR, "*.toml")))

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from gaitbot.cli import main
+from gaitbot.app.cli import main
 from gaitbot.gait.terrain.envelope import REFERENCE_MARGIN_M, StepEnvelope, course_problems
 from gaitbot.gait.terrain.model import Terrain, Tread
 from gaitbot.robot.config import ConfigError, load_robot_config

@@ -5,7 +5,7 @@ from pathlib import Path
 import pytest
 
 from gaitbot.gait.terrain.model import Terrain, TerrainError, Tread
-from gaitbot.terrain_file import TerrainFileError, load_course
+from gaitbot.gait.terrain.course_file import TerrainFileError, load_course
 
 EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "config" / "terrain").glob("*.toml"))
 

@@ -9,7 +9,7 @@ import pytest
 from gaitbot.gait.terrain.envelope import StepEnvelope
 from gaitbot.gait.terrain.footholds import CourseError, FootholdLimits, plan_footholds
 from gaitbot.gait.terrain.model import Terrain, Tread
-from gaitbot.terrain_file import load_course
+from gaitbot.gait.terrain.course_file import load_course
 from terrain_profile import surface_pieces
 
 EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "config" / "terrain").glob("*.toml"))

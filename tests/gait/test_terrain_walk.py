@@ -11,15 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gaitbot.check import check_trajectory
-from gaitbot.cli import main
+from gaitbot.check.trajectory import check_trajectory
+from gaitbot.app.cli import main
 from gaitbot.gait.terrain.model import Terrain, Tread
 from gaitbot.gait.terrain.walk import plan_terrain_walk
 from gaitbot.gait.walker import make_context
 from gaitbot.robot.config import load_robot_config
-from gaitbot.robot.gait_setup import leg_geometry, walk_settings
-from gaitbot.session import GaitSource, terrain_settings
-from gaitbot.terrain_file import Course, load_course
+from gaitbot.robot.walk_settings import leg_geometry, walk_settings
+from gaitbot.app.options import GaitSource, terrain_settings
+from gaitbot.gait.terrain.course_file import Course, load_course
 from terrain_profile import height, surface_pieces
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -20,7 +20,7 @@ from gaitbot.robot.config import (
     resolve_config,
     shipped_config_names,
 )
-from gaitbot.robot.servo_models import SERVO_MODELS
+from gaitbot.servos.models import SERVO_MODELS
 
 SHIPPED = ("xl430-biped", "sts3215-biped", "ax12a-biped")
 

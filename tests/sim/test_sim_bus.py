@@ -10,17 +10,17 @@ import math
 import numpy as np
 import pytest
 
-from gaitbot.bus.sim import SimUnavailable, import_mujoco  # noqa: E402  (picks the offscreen GL first)
+from gaitbot.sim import SimUnavailable, import_mujoco  # noqa: E402  (picks the offscreen GL first)
 
 try:
     import_mujoco()
 except SimUnavailable:
     pytest.skip("the sim extra (MuJoCo) is not installed", allow_module_level=True)
 
-from gaitbot.bus.sim.physics import SimRobot  # noqa: E402
-from gaitbot.bus.sim.sim_bus import SimPort, make_sim_bus  # noqa: E402
-from gaitbot.cli import main  # noqa: E402
-from gaitbot.clock import VirtualClock  # noqa: E402
+from gaitbot.sim.physics import SimRobot  # noqa: E402
+from gaitbot.sim.port import SimPort, make_sim_bus  # noqa: E402
+from gaitbot.app.cli import main  # noqa: E402
+from gaitbot.stream.clock import VirtualClock  # noqa: E402
 from gaitbot.robot.config import load_robot_config, resolve_config  # noqa: E402
 from test_sim_model import float_in_air  # noqa: E402
 
@@ -35,7 +35,7 @@ def sim_bus(name: str):
     config = load_robot_config(resolve_config(name))
     robot = SimRobot(config, 60.0)
     clock = VirtualClock()
-    return config, robot, clock, make_sim_bus(config, robot, clock)
+    return config, robot, clock, make_sim_bus(config, robot, clock.now)
 
 
 @pytest.mark.parametrize("name", ROBOTS)

@@ -15,17 +15,17 @@ from pathlib import Path
 
 import pytest
 
-from gaitbot.bus.sim import SimUnavailable, import_mujoco  # noqa: E402  (picks the offscreen GL first)
+from gaitbot.sim import SimUnavailable, import_mujoco  # noqa: E402  (picks the offscreen GL first)
 
 try:
     import_mujoco()
 except SimUnavailable:
     pytest.skip("the sim extra (MuJoCo) is not installed", allow_module_level=True)
 
-from gaitbot.bus.sim.physics import SimRobot  # noqa: E402
-from gaitbot.bus.sim.sim_bus import make_sim_bus  # noqa: E402
-from gaitbot.cli import main  # noqa: E402
-from gaitbot.clock import VirtualClock  # noqa: E402
+from gaitbot.sim.physics import SimRobot  # noqa: E402
+from gaitbot.sim.port import make_sim_bus  # noqa: E402
+from gaitbot.app.cli import main  # noqa: E402
+from gaitbot.stream.clock import VirtualClock  # noqa: E402
 from gaitbot.robot.config import load_robot_config, resolve_config  # noqa: E402
 from test_sim_model import float_in_air  # noqa: E402
 
@@ -44,7 +44,7 @@ def loaded_knee_deflection_deg(name: str, writes: list[tuple[int, int, int]]) ->
     robot = SimRobot(config, 60.0)
     float_in_air(robot)
     clock = VirtualClock()
-    bus = make_sim_bus(config, robot, clock)
+    bus = make_sim_bus(config, robot, clock.now)
     knee = config.walking_joints[KNEE_LEFT]
     with bus:
         for address, length, value in writes:

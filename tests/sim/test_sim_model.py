@@ -12,14 +12,14 @@ import math
 import numpy as np
 import pytest
 
-from gaitbot.bus.sim import SimUnavailable, import_mujoco  # noqa: E402  (picks the offscreen GL first)
+from gaitbot.sim import SimUnavailable, import_mujoco  # noqa: E402  (picks the offscreen GL first)
 
 try:
     import_mujoco()
 except SimUnavailable:
     pytest.skip("the sim extra (MuJoCo) is not installed", allow_module_level=True)
 
-from gaitbot.bus.sim.physics import SimRobot  # noqa: E402
+from gaitbot.sim.physics import SimRobot  # noqa: E402
 from gaitbot.robot.config import load_robot_config, resolve_config  # noqa: E402
 
 ROBOTS = ("xl430-biped", "sts3215-biped", "ax12a-biped")

@@ -14,14 +14,14 @@ from pathlib import Path
 
 import pytest
 
-from gaitbot.bus.sim import SimUnavailable, import_mujoco  # noqa: E402  (picks the offscreen GL first)
+from gaitbot.sim import SimUnavailable, import_mujoco  # noqa: E402  (picks the offscreen GL first)
 
 try:
     import_mujoco()
 except SimUnavailable:
     pytest.skip("the sim extra (MuJoCo) is not installed", allow_module_level=True)
 
-from gaitbot.cli import main  # noqa: E402
+from gaitbot.app.cli import main  # noqa: E402
 
 CONFIG_DIR = Path(__file__).resolve().parents[1] / "config"
 ROBOTS = ("xl430-biped", "sts3215-biped", "ax12a-biped")

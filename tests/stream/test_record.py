@@ -13,16 +13,16 @@ import pytest
 
 pytest.importorskip("dynamixel_sdk")
 
-from gaitbot.bus import wire  # noqa: E402
+from gaitbot.servos import wire  # noqa: E402
 from gaitbot.bus.factory import make_bus  # noqa: E402
 from gaitbot.bus.guard import LimitGuard  # noqa: E402
-from gaitbot.cli import main  # noqa: E402
-from gaitbot.clock import VirtualClock  # noqa: E402
+from gaitbot.app.cli import main  # noqa: E402
+from gaitbot.stream.clock import VirtualClock  # noqa: E402
 from gaitbot.gait.trajectory import Trajectory  # noqa: E402
-from gaitbot.record import record_session  # noqa: E402
-from gaitbot.record_command import QUESTION, TrajectorySink  # noqa: E402
+from gaitbot.stream.record import record_session  # noqa: E402
+from gaitbot.app.record import QUESTION, TrajectorySink  # noqa: E402
 from gaitbot.robot.calibration import tick_limits  # noqa: E402
-from gaitbot.session import load_robot  # noqa: E402
+from gaitbot.app.options import load_robot  # noqa: E402
 from gaitbot.stream import Terminated  # noqa: E402
 
 CFG = load_robot("xl430-biped")

@@ -20,15 +20,15 @@ from gaitbot.bus.factory import make_bus
 from gaitbot.bus.feetech import FeetechBus
 from gaitbot.bus.guard import LimitGuard
 from gaitbot.bus.mock import MockPort
-from gaitbot.bus.recording import BusRecorder
-from gaitbot.check_recording import check_recording
-from gaitbot.cli import main
-from gaitbot.clock import VirtualClock
-from gaitbot.record import record_session
+from gaitbot.bus.log import BusRecorder
+from gaitbot.check.recording import check_recording
+from gaitbot.app.cli import main
+from gaitbot.stream.clock import VirtualClock
+from gaitbot.stream.record import record_session
 from gaitbot.robot.calibration import tick_limits
 from gaitbot.robot.config import load_robot_config
-from gaitbot.robot.servo_models import SERVO_MODELS
-from gaitbot.session import gain_writes
+from gaitbot.servos.models import SERVO_MODELS
+from gaitbot.app.options import gain_writes
 from test_walk_cli import crc16, parse_packet  # noqa: E402 - the independent decoder
 
 CONFIG_DIR = Path(__file__).resolve().parents[1] / "config"

@@ -16,10 +16,11 @@ import numpy as np
 import pytest
 
 from gaitbot.bus.base import Bus, BusError, ServoTimeout
-from gaitbot.clock import MonotonicClock, VirtualClock
-from gaitbot.ramp import brake_ticks, ramp_ticks, stop_ticks
+from gaitbot.stream.clock import MonotonicClock, VirtualClock
+from gaitbot.stream.ramps import brake_ticks, ramp_ticks, stop_ticks
+from gaitbot.bus.serial_latency import latency_timer_warning
 from gaitbot.stream import (
-    EXIT_CODES, MissingServosError, Streamer, latency_timer_warning, prepare, walk_session,
+    EXIT_CODES, MissingServosError, Streamer, prepare, walk_session,
 )
 
 PERIOD_S = 1 / 60

@@ -13,9 +13,9 @@ import pytest
 pytest.importorskip("dynamixel_sdk")
 
 from gaitbot.bus.factory import make_bus  # noqa: E402
-from gaitbot.bus.recording import BusRecorder, decode_goal_frames  # noqa: E402
-from gaitbot.clock import VirtualClock  # noqa: E402
-from gaitbot.robot.servo_models import servo_model  # noqa: E402
+from gaitbot.bus.log import BusRecorder, decode_goal_frames  # noqa: E402
+from gaitbot.stream.clock import VirtualClock  # noqa: E402
+from gaitbot.servos.models import servo_model  # noqa: E402
 from gaitbot.stream import walk_session  # noqa: E402
 
 PERIOD_S = 1 / 60

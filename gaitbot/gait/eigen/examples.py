@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gaitbot.errors import UserError
+
 from ..footfall import CONTACT_TOL_FRACTION, detect_heel_strikes, foot_heights_in_body, heel_world_x
 from ..geometry import LegGeometry
 from ..trajectory import Trajectory
@@ -27,7 +29,7 @@ __all__ = ["CONTACT_TOL_FRACTION", "ExampleCycle", "ExampleError", "cycles_from_
            "foot_heights_in_body", "heel_world_x", "walk_label"]
 
 
-class ExampleError(ValueError):
+class ExampleError(UserError, ValueError):
     """An example file cannot give example cycles; the message names the file and why."""
 
 

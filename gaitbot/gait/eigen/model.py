@@ -30,6 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
+from gaitbot.errors import UserError
+
 from ..geometry import LegGeometry
 from .align import align_to_reference, resample_cycle, sample_phases
 from .basis import fit_coefficients, make_basis
@@ -40,7 +42,7 @@ MODEL_KIND = "gaitbot-eigen-gait"
 MODEL_VERSION = 1
 
 
-class EigenModelError(ValueError):
+class EigenModelError(UserError, ValueError):
     """Bad input to fitting or synthesis (too few examples, unreachable pose, ...): one line for people."""
 
 

@@ -1,0 +1,19 @@
+"""``gaitbot generate``: the trajectory of a walk, written as CSV or NPZ (docs/file-formats.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from gaitbot.app.options import UsageError
+from gaitbot.app.walks import trajectory_for_robot
+
+
+def run(args) -> int:
+    out = Path(args.output)
+    if out.suffix not in (".csv", ".npz"):
+        raise UsageError(f"-o {out}: the output must end in .csv or .npz")
+    _, walker, trajectory = trajectory_for_robot(args)
+    trajectory.save(out)
+    print(f"wrote {out}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
+          f"{len(walker.heel_strikes)} heel strikes, {trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.4f} m")
+    return 0

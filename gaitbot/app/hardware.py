@@ -1,0 +1,36 @@
+"""Opening the hardware from the command line: the serial port (it must exist) and its adapter's latency.
+
+The bus itself, behind its LimitGuard, comes from gaitbot.bus.factory.make_robot_bus (written once,
+used by walk, record and scan).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from gaitbot.app.options import UsageError
+from gaitbot.bus.serial_latency import latency_timer_warning
+from gaitbot.robot.config import RobotConfig
+
+
+def require_port(port: str) -> None:
+    """A real run needs a serial device that exists: say which one is missing and how to list them."""
+    if not Path(port).exists():
+        raise UsageError(f"--port {port}: no such serial port (list them with: python -m serial.tools.list_ports -v; "
+                         f"or try --dry-run)")
+
+
+def serial_port(config: RobotConfig, port: str | None, dry_run: bool) -> str:
+    """``--port``, else the config's; outside a dry run it must exist."""
+    port = port or config.bus.port
+    if not dry_run:
+        require_port(port)
+    return port
+
+
+def warn_about_latency(port: str) -> None:
+    """One warning line on stderr when the port's USB adapter holds replies back (see serial_latency)."""
+    warning = latency_timer_warning(port)
+    if warning:
+        print(f"warning: {warning}", file=sys.stderr)

@@ -1,0 +1,96 @@
+"""``gaitbot plan``: the step plan (lengths, RV, timing, footholds), as a table or one JSON object."""
+
+from __future__ import annotations
+
+import json
+import math
+
+from gaitbot.app.walks import trajectory_for_robot
+from gaitbot.gait.walker import OnlineWalker
+from gaitbot.robot.walk_settings import GaitSource
+
+
+def run(args) -> int:
+    if getattr(args, "terrain", None) is not None:
+        return _plan_terrain(args)
+    source, walker, _ = trajectory_for_robot(args)
+    plan = plan_summary(source, walker)
+    if args.json:
+        print(json.dumps(plan, indent=2))
+        return 0
+    print(f"{'step':>4} {'leg':>5} {'length m':>9} {'RV':>7} {'start s':>8} {'end s':>7} {'foothold m':>10}")
+    for s in plan["steps"] + ([plan["closing_step"]] if plan["closing_step"] else []):
+        label = "close" if s["closing"] else str(s["index"])
+        print(f"{label:>4} {s['leg']:>5} {s['length_m']:9.4f} {s['rv']:7.4f} {s['start_s']:8.3f} {s['end_s']:7.3f} "
+              f"{s['foothold_m']:10.4f}")
+    print(f"{plan['n_steps']} steps, {plan['total_distance_m']:.4f} m in {plan['duration_s']:.2f} s "
+          f"(cycle {plan['cycle_s']:.4f} s, {plan['rate_hz']:g} Hz, reachable step 0 to "
+          f"{plan['reachable_step_m'][1]:.4f} m, allowed up to {plan['max_step_m']:.4f} m)")
+    return 0
+
+
+def _plan_terrain(args) -> int:
+    source, walk, _ = trajectory_for_robot(args)
+    plan = terrain_plan_summary(source, walk)
+    if args.json:
+        print(json.dumps(plan, indent=2))
+        return 0
+    print(f"{'step':>4} {'leg':>5} {'length m':>9} {'start s':>8} {'end s':>7} {'foothold m':>10} {'height m':>8} "
+          f"{'method':>8} {'lift m':>7}")
+    for s in plan["steps"]:
+        label = "close" if s["closing"] else str(s["index"])
+        print(f"{label:>4} {s['leg']:>5} {s['length_m']:9.4f} {s['start_s']:8.3f} {s['end_s']:7.3f} "
+              f"{s['foothold_m']:10.4f} {s['height_m']:8.4f} {s['method']:>8} {s['lift_m']:7.4f}")
+    for i, r in enumerate(plan["searches"], start=1):
+        centre = f"{r['centre_cost']:.4g}" if r["centre_cost"] is not None else "unreachable"
+        print(f"MDS {i}: pelvis at ({r['mds_m'][0]:.4f}, {r['mds_m'][1]:.4f}) m, cost {r['cost']:.4g} "
+              f"(middle of the region: {centre}); {r['evaluated']} cells scored, {r['pruned']} skipped as "
+              f"unreachable, of {r['full_grid']} in a full search")
+    print(f"{plan['n_steps']} steps ({plan['n_terrain_steps']} on terrain), {plan['duration_s']:.2f} s, "
+          f"{plan['n_frames']} frames; grid search scored {plan['cells_evaluated']} cells against "
+          f"{plan['cells_full_search']} for full searches")
+    return 0
+
+
+def plan_summary(source: GaitSource, walker: OnlineWalker) -> dict:
+    """The plan as a JSON-ready object: requested steps, the closing step, footholds and totals."""
+    steps = [s.to_dict() for s in walker.planned_steps if not s.closing]
+    closing = [s.to_dict() for s in walker.planned_steps if s.closing]
+    n_frames = walker._planned_frames
+    return {
+        "robot": source.robot.name if source.robot is not None else None,
+        "leg_length_m": source.geometry.leg_length,
+        "cycle_s": walker.ctx.cycle_s,
+        "rate_hz": walker.ctx.rate_hz,
+        "reachable_step_m": list(walker.ctx.inverse.reachable_range),
+        "max_step_m": source.max_step_m,
+        "steps": steps,
+        "closing_step": closing[0] if closing else None,
+        "heel_strikes": [{"t_s": h.t_s, "leg": h.leg, "x_m": h.x_m} for h in walker.heel_strikes],
+        "total_distance_m": walker.heel_strikes[-1].x_m if walker.heel_strikes else 0.0,
+        "n_steps": len(steps),
+        "duration_s": (n_frames - 1) / walker.ctx.rate_hz,
+        "n_frames": n_frames,
+    }
+
+
+def terrain_plan_summary(source: GaitSource, walk) -> dict:
+    """A terrain plan as a JSON-ready object: steps with their method, footholds, and the grid searches."""
+    searches = [{"mds_m": list(r.point), "cost": r.cost, "centre_cost": r.centre_cost if math.isfinite(r.centre_cost)
+                 else None, "evaluated": r.evaluated, "pruned": r.pruned, "full_grid": r.full_grid}
+                for r in walk.search_reports]
+    traj = walk.trajectory
+    return {
+        "robot": source.robot.name if source.robot is not None else None,
+        "leg_length_m": source.geometry.leg_length,
+        "rate_hz": walk.ctx.rate_hz,
+        "steps": [s.to_dict() for s in walk.steps],
+        "n_steps": len(walk.steps),
+        "n_terrain_steps": sum(1 for s in walk.steps if s.method == "terrain"),
+        "searches": searches,
+        "cells_evaluated": sum(r.evaluated for r in walk.search_reports),
+        "cells_full_search": sum(r.full_grid for r in walk.search_reports),
+        "duration_s": float(traj.t_s[-1]),
+        "n_frames": len(traj),
+        "total_distance_m": walk.steps[-1].foothold_m - (walk.steps[0].foothold_m - walk.steps[0].length_m),
+    }

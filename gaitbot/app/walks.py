@@ -1,0 +1,90 @@
+"""From the walk options (``--steps`` / ``--distance``, ``--terrain FILE``, ``--trajectory FILE``) to a
+plan and a trajectory, for ``plan``, ``generate`` and ``walk``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gaitbot.app.options import UsageError, check_rate_option, gait_source, step_lengths
+from gaitbot.gait.segments import GaitGenerationError
+from gaitbot.gait.step_length import StepLengthError
+from gaitbot.gait.terrain.course_file import load_course
+from gaitbot.gait.terrain.footholds import CourseError
+from gaitbot.gait.terrain.walk import plan_terrain_walk
+from gaitbot.gait.trajectory import Trajectory
+from gaitbot.gait.walker import OnlineWalker, WalkSettings, make_context, plan_walk, trajectory_of
+from gaitbot.robot.walk_settings import GaitSource, terrain_settings
+
+
+def build_walk(args) -> tuple[GaitSource, OnlineWalker]:
+    """A planned, closed walker for the arguments (all frames computed)."""
+    source = gait_source(args)
+    steps = step_lengths(args, source)
+    try:
+        return source, plan_walk(source.geometry, steps, source.settings)
+    except StepLengthError as exc:
+        raise UsageError(str(exc)) from None
+
+
+@dataclass(frozen=True)
+class FileWalk:
+    """A trajectory file walked as it is (``walk --trajectory``): its heel strikes stand for the plan."""
+
+    heel_strikes: tuple
+
+    @property
+    def planned_steps(self) -> tuple:
+        return self.heel_strikes
+
+
+#: A trajectory file's sample times must be this close to one period apart (share of the period).
+UNIFORM_RATE_TOL = 1e-3
+
+
+def trajectory_file_walk(args) -> tuple[GaitSource, FileWalk, Trajectory]:
+    """``--trajectory FILE``: the file streamed frame by frame at its own (uniform) rate, which the bus must carry."""
+    if getattr(args, "rate", None) is not None:
+        raise UsageError("--rate: a trajectory file is walked at its own frame rate; leave --rate out")
+    source = gait_source(args)
+    trajectory = Trajectory.load(args.trajectory)
+    periods = np.diff(trajectory.t_s)
+    period = float(np.median(periods))
+    worst = float(np.abs(periods - period).max())
+    if worst > UNIFORM_RATE_TOL * period:
+        k = int(np.argmax(np.abs(periods - period)))
+        raise UsageError(f"--trajectory {args.trajectory}: samples are not evenly spaced (row {k + 3} comes "
+                         f"{periods[k]:.6g} s after the one before, the median spacing is {period:.6g} s); "
+                         f"the robot is sent one row per frame")
+    rate = 1.0 / period
+    if source.robot is not None:
+        check_rate_option(source.robot, rate, f"--trajectory {args.trajectory}: its {rate:.4g} Hz")
+    settings = WalkSettings(source.settings.cycle_s, rate, source.settings.clearance)
+    return GaitSource(source.geometry, settings, source.max_step_m, source.robot), \
+        FileWalk(tuple(trajectory.heel_strikes)), trajectory
+
+
+def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:
+    if getattr(args, "trajectory", None) is not None:
+        return trajectory_file_walk(args)
+    if getattr(args, "terrain", None) is not None:
+        source, walk = build_terrain_walk(args)
+        return source, walk, walk.trajectory
+    source, walker = build_walk(args)
+    return source, walker, trajectory_of(walker)
+
+
+def build_terrain_walk(args):
+    """Footholds, pelvis search and trajectory for ``--terrain FILE`` (seed 003 joined to the flat walker)."""
+    source = gait_source(args)
+    course = load_course(args.terrain)
+    settings = terrain_settings(source, course, getattr(args, "clearance", None))
+    try:
+        walk = plan_terrain_walk(make_context(source.geometry, source.settings), course.terrain, course.start_m,
+                                 course.end_m, settings, source.max_step_m)
+    except CourseError as exc:
+        raise UsageError(f"{course.path}: {exc}") from None
+    except GaitGenerationError as exc:
+        raise GaitGenerationError(f"{course.path}: {exc}") from None
+    return source, walk

@@ -1,0 +1,53 @@
+"""The servos room: vendor facts as data, importing nothing else of gaitbot.
+
+One module per vendor (``dynamixel``, ``feetech``: control tables, model numbers, baud rates, id
+ranges, error bits), the servo models built from them (``models``), packet framing written from the
+protocol documents (``wire``) and status bytes in words (``status``). The list of backends is
+written here and nowhere else.
+"""
+
+from __future__ import annotations
+
+from types import ModuleType
+
+from gaitbot.servos import dynamixel, feetech
+from gaitbot.servos.registers import ControlTable, Register, RegisterWrite
+
+#: Backend name -> its vendor module. The one list of the backends gaitbot speaks.
+VENDORS: dict[str, ModuleType] = {dynamixel.NAME: dynamixel, feetech.NAME: feetech}
+BACKENDS: tuple[str, ...] = tuple(VENDORS)
+
+#: Return Delay Time assumed per status packet when budgeting the bus: 250 x 2 us is the factory
+#: value on Dynamixel X, AX and XL-320; Feetech series differ by firmware, so the same (longer,
+#: safe) figure is assumed for them.
+ASSUMED_RETURN_DELAY_S = 500e-6
+
+
+def vendor(backend: str) -> ModuleType:
+    """The vendor module of ``backend``; ValueError naming the known ones."""
+    try:
+        return VENDORS[backend]
+    except KeyError:
+        raise ValueError(f"unknown backend {backend!r} (known: {', '.join(BACKENDS)})") from None
+
+
+def max_servo_id(backend: str, protocol: float) -> int:
+    """Highest usable servo id on a ``backend`` bus speaking ``protocol``."""
+    return vendor(backend).MAX_ID[float(protocol)]
+
+
+def has_sync_read(backend: str, protocol: float, byte_order: str) -> bool:
+    """Whether the servos answer a SYNC READ (else each one is read on its own)."""
+    return vendor(backend).has_sync_read(protocol, byte_order)
+
+
+def control_table(model_name: str) -> ControlTable:
+    """The control table of a servo model, from its vendor's module."""
+    for module in VENDORS.values():
+        if model_name in module.CONTROL_TABLES:
+            return module.CONTROL_TABLES[model_name]
+    raise KeyError(f"no control table for servo model {model_name!r}")
+
+
+__all__ = ["VENDORS", "BACKENDS", "ASSUMED_RETURN_DELAY_S", "ControlTable", "Register", "RegisterWrite", "vendor",
+           "max_servo_id", "has_sync_read", "control_table", "dynamixel", "feetech"]
