@@ -1,14 +1,47 @@
-"""Helpers shared by the check tests (no tests here; named test_check_* to stay in the check room):
-run the real CLI, make dry-run recordings, and edit recordings packet by packet (re-framed with a
-valid checksum/CRC unless the test wants it broken)."""
+"""Helpers shared by the tests (no tests here; conftest.py puts this folder on the path).
+
+The repository's folders; the real CLI run in-process; recordings edited packet by packet
+(re-framed with a valid checksum/CRC unless the test wants it broken); a packet decoder written
+from the protocol documents, independently of gaitbot's; the tests' own terrain profile; the
+simulated robot floated in the air.
+"""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
-from gaitbot.servos import wire
+import numpy as np
+
 from gaitbot.app.cli import main
 from gaitbot.robot.config import load_robot_config, resolve_config
+from gaitbot.servos import wire
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+CONFIG_DIR = REPO_ROOT / "config"
+WALK_TIMEOUT_S = 60  # a hang fails the test instead of the suite
+
+# --- the command line and the emulator
+
+
+def gaitbot(*args: str, timeout: float = WALK_TIMEOUT_S) -> subprocess.CompletedProcess:
+    """The gaitbot command line in a subprocess, as a user runs it."""
+    return subprocess.run([sys.executable, "-m", "gaitbot.app.cli", *args], capture_output=True, text=True,
+                          timeout=timeout, stdin=subprocess.DEVNULL, cwd=REPO_ROOT)
+
+
+def emulator_for(config_path: Path, log_path: Path, faults=None):
+    """The servo emulator (gaitbot.bus.emulator) of a robot config on a pty, logging the goals it receives."""
+    from gaitbot.bus import emulator as se
+
+    robot = load_robot_config(config_path)
+    return se.ServoEmulator(se.EmulatorConfig(
+        robot.bus.backend, robot.bus.protocol, robot.models_by_id, robot.bus.baudrate, faults or se.Faults(),
+        str(log_path), robot.name, {j.name: j.id for j in robot.joints}))
+
+
+# --- recordings
 
 ROBOTS = ("xl430-biped", "sts3215-biped", "ax12a-biped")
 PERIOD_S = 1.0 / 60.0
@@ -87,3 +120,73 @@ def goal_line_indices(rows: list[dict], robot: str) -> list[int]:
 def goal_row_near(rows: list[dict], robot: str, t_s: float) -> int:
     """Index of the goal sync write whose time is closest to ``t_s``."""
     return min(goal_line_indices(rows, robot), key=lambda k: abs(rows[k]["t"] - t_s))
+
+
+# --- an independent packet decoder (ROBOTIS protocol 1.0 / Feetech checksum = ~(sum of id..params) & 0xFF;
+# protocol 2.0 CRC-16 with polynomial 0x8005, initial value 0, no reflection: the e-Manual), bit by bit
+
+
+def crc16(data: bytes) -> int:
+    crc = 0
+    for byte in data:
+        crc ^= byte << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x8005) if crc & 0x8000 else (crc << 1)
+            crc &= 0xFFFF
+    return crc
+
+
+def parse_packet(raw: bytes, protocol: float):
+    """(id, instruction, params) of one instruction packet; raises AssertionError if malformed."""
+    if protocol == 2.0:
+        assert raw[:4] == b"\xff\xff\xfd\x00", raw.hex()
+        length = raw[5] | raw[6] << 8
+        assert len(raw) == 7 + length, raw.hex()
+        assert crc16(raw[:-2]) == (raw[-2] | raw[-1] << 8), f"bad CRC {raw.hex()}"
+        body = raw[7:-2].replace(b"\xff\xff\xfd\xfd", b"\xff\xff\xfd")  # unstuff
+        return raw[4], body[0], body[1:]
+    assert raw[:2] == b"\xff\xff", raw.hex()
+    length = raw[3]
+    assert len(raw) == 4 + length, raw.hex()
+    assert (~sum(raw[2:-1])) & 0xFF == raw[-1], f"bad checksum {raw.hex()}"
+    return raw[2], raw[4], raw[5:-1]
+
+
+# --- the tests' own terrain profile, built from the treads independently of gaitbot's Terrain: ground at 0
+# outside the treads, neighbouring pieces of equal height merged into one surface
+
+
+def surface_pieces(treads):
+    """[start, end, height] pieces covering the whole x axis, in order."""
+    pieces, x = [], -np.inf
+    for t in sorted(treads, key=lambda t: t.start_m):
+        if t.start_m > x + 1e-9:
+            pieces.append([x, t.start_m, 0.0])
+        pieces.append([t.start_m, t.start_m + t.length_m, t.height_m])
+        x = t.start_m + t.length_m
+    pieces.append([x, np.inf, 0.0])
+    merged = []
+    for p in pieces:
+        if merged and merged[-1][2] == p[2] and abs(merged[-1][1] - p[0]) < 1e-9:
+            merged[-1][1] = p[1]
+        else:
+            merged.append(p)
+    return merged
+
+
+def height(pieces, x):
+    """Terrain height under each x (at an edge: the higher side)."""
+    out = np.zeros_like(x)
+    for i, xi in enumerate(x):
+        out[i] = max(h for s, e, h in pieces if s - 1e-12 <= xi <= e + 1e-12)
+    return out
+
+
+# --- the simulated robot (gaitbot.sim.physics.SimRobot)
+
+
+def float_in_air(robot) -> None:
+    """Lift the robot off the floor and switch gravity off: only the servos act on the legs."""
+    robot.model.opt.gravity[:] = 0.0
+    robot.data.qpos[robot.model.joint("boom_z").qposadr[0]] = 0.5
+    robot.mujoco.mj_forward(robot.model, robot.data)

@@ -169,8 +169,8 @@ class LogLine:
 
 @dataclass(frozen=True)
 class BusLog:
-    """A read bus log: the validated header (joints name -> id, models id -> name, protocol a float),
-    every packet line, and the line number of a truncated last line that was dropped (None: none)."""
+    """A read bus log: the validated header (as written; ``typed_header`` gives its typed values), every
+    packet line, and the line number of a truncated last line that was dropped (None: none)."""
 
     path: Path
     header: dict
@@ -256,16 +256,20 @@ def _header(path: Path, line: str) -> dict:
     if not isinstance(joints, dict) or not isinstance(models, dict):
         raise RecordingError(f"{path}:1: header joints and models must be objects")
     try:
-        header["joints"] = {str(k): int(v) for k, v in joints.items()}
-        header["models"] = {int(k): str(v) for k, v in models.items()}
-        header["protocol"] = float(header["protocol"])
-        for name in header["models"].values():
+        for name in typed_header(header)["models"].values():
             servo_model(name)
     except (TypeError, ValueError, KeyError) as exc:
         raise RecordingError(f"{path}:1: bad header joints/models/protocol: {exc}") from None
     if header["backend"] not in BACKENDS:
         raise RecordingError(f"{path}:1: unknown backend {header['backend']!r} ({' or '.join(BACKENDS)})")
     return header
+
+
+def typed_header(header: dict) -> dict:
+    """A copy of a header as read (JSON: string keys) with typed values: joints name -> int id, models
+    int id -> name, protocol a float."""
+    return {**header, "joints": {str(k): int(v) for k, v in header["joints"].items()},
+            "models": {int(k): str(v) for k, v in header["models"].items()}, "protocol": float(header["protocol"])}
 
 
 def _line(path: Path, line_no: int, line: str) -> LogLine:
@@ -413,7 +417,7 @@ def _instruction_fields(frame: wire.Frame, framing: str):
 
 def _goal_layout(path: Path, header: dict) -> tuple[tuple[int, int], dict[int, str]]:
     """((goal address, length), {id: byte order}) from the header's models."""
-    models = {i: servo_model(name) for i, name in header["models"].items()}
+    models = {i: servo_model(name) for i, name in typed_header(header)["models"].items()}
     layouts = {(m.addr_goal_position, m.len_goal_position) for m in models.values()}
     if len(layouts) != 1:
         raise RecordingError(f"{path}:1: header models do not share one goal-position address")

@@ -48,7 +48,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gaitbot.bus.log import BusLog, RecordedPacket, RecordingError, parse_packet, read_header, read_log
+from gaitbot.bus import log as bus_log
+from gaitbot.bus.log import BusLog, RecordedPacket, RecordingError, parse_packet, read_header, typed_header
 from gaitbot.check.settings import SettingWrite, describe_settings, setting_write
 from gaitbot.check.trajectory import CheckReport, check_trajectory
 from gaitbot.robot.calibration import ticks_to_angles
@@ -252,6 +253,14 @@ class _Logged:
     problem: str
 
 
+def read_log(path: str | Path, *, allow_partial_last_line: bool = False) -> tuple[dict, list[_Logged], list[BusIssue]]:
+    """A recording read by its format's reader (gaitbot.bus.log), as the checks take it: the typed header,
+    every packet line parsed, and file-level warnings. RecordingError (exit 2) for an unreadable file."""
+    log = bus_log.read_log(path, allow_partial_last_line=allow_partial_last_line)
+    packets, notes = _packets(log)
+    return typed_header(log.header), packets, notes
+
+
 def _packets(log: BusLog) -> tuple[list[_Logged], list[BusIssue]]:
     """Every packet line of a log (gaitbot.bus.log, the format's reader) parsed, and file-level warnings."""
     packets = []
@@ -329,9 +338,7 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
     Raises RecordingError (RecordingMismatch) for a file that cannot be checked: unreadable, no
     header, a config of another robot, or no goal frames at all.
     """
-    log = read_log(path, allow_partial_last_line=allow_partial_last_line)
-    header = log.header
-    packets, issues = _packets(log)
+    header, packets, issues = read_log(path, allow_partial_last_line=allow_partial_last_line)
     issues += match_config(path, header, config)
     names = {j.id: j.name for j in config.joints}
     column = {j.id: c for c, j in enumerate(config.joints)}

@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from test_check_support import PERIOD_S, ROBOTS, run_cli
+from helpers import REPO_ROOT, PERIOD_S, ROBOTS, run_cli
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = REPO_ROOT
 COLUMNS = ["t_s", "hip_pitch_left_deg", "knee_pitch_left_deg", "ankle_pitch_left_deg", "hip_pitch_right_deg",
            "knee_pitch_right_deg", "ankle_pitch_right_deg", "root_x_m", "root_y_m"]
 
@@ -89,7 +89,7 @@ def test_knee_set_to_130_deg_at_2s(capsys, tmp_path, walks, robot):
 def hip_limits(robot):
     """(max_velocity_dps, max_acceleration_dps2) of hip_pitch_left from the shipped TOML; the edits
     below are sized for 300 deg/s and 12000 deg/s^2."""
-    from test_check_support import config
+    from helpers import config
 
     joint = config(robot).joint("hip_pitch_left")
     assert (joint.max_velocity_dps, joint.max_acceleration_dps2) == (300.0, 12000.0)

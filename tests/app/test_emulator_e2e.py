@@ -22,12 +22,12 @@ import pytest
 from gaitbot.bus.log import decode_goal_frames
 from gaitbot.robot.config import load_robot_config
 
-from test_emulator import se  # noqa: E402 - the emulator module, loaded from tools/
+from gaitbot.bus import emulator as se  # noqa: E402 - the emulator, imported as a module
+from helpers import REPO_ROOT, emulator_for, gaitbot
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = REPO_ROOT
 CONFIGS = {"dxl2": ROOT / "config" / "xl430-biped.toml", "dxl1": ROOT / "config" / "ax12a-biped.toml",
            "feetech-sts": ROOT / "config" / "sts3215-biped.toml"}
-WALK_TIMEOUT_S = 60  # a hang fails the test instead of the suite
 #: Stated stop bound: from the first frame the fault touches to the last packet the driver sends.
 #: Detection (4 reads of at most ~34 ms reply timeout + 40 ms late-reply watch) plus the stop ramp
 #: (under 1 s for the shipped configs) plus torque-off.
@@ -43,18 +43,6 @@ def scs_config(tmp_path: Path) -> Path:
     path = tmp_path / "scs0009-biped.toml"
     path.write_text(text)
     return path
-
-
-def gaitbot(*args: str, timeout: float = WALK_TIMEOUT_S) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "gaitbot.app.cli", *args], capture_output=True, text=True,
-                          timeout=timeout, stdin=subprocess.DEVNULL, cwd=ROOT)
-
-
-def emulator_for(config_path: Path, log_path: Path, faults=None):
-    robot = load_robot_config(config_path)
-    return se.ServoEmulator(se.EmulatorConfig(
-        robot.bus.backend, robot.bus.protocol, robot.models_by_id, robot.bus.baudrate, faults or se.Faults(),
-        str(log_path), robot.name, {j.name: j.id for j in robot.joints}))
 
 
 def walk_through_emulator(config_path: Path, workdir: Path, walk_args: list[str], faults=None):

@@ -34,9 +34,10 @@ from gaitbot.robot.calibration import angles_to_ticks
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 from gaitbot.app.options import load_robot
 
-from test_emulator import se  # noqa: E402 - the emulator module, loaded from tools/
+from gaitbot.bus import emulator as se  # noqa: E402 - the emulator, imported as a module
+from helpers import REPO_ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = REPO_ROOT
 REPLY_TIMEOUT_MS = 250
 STEPS = (0.03, 0.06, 0.09)
 

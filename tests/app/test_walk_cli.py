@@ -15,35 +15,10 @@ import pytest
 from gaitbot.app.cli import main
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.config import load_robot_config
+from helpers import CONFIG_DIR, crc16, parse_packet
 
-CONFIGS = sorted((Path(__file__).resolve().parents[1] / "config").glob("*.toml"))
+CONFIGS = sorted(CONFIG_DIR.glob("*.toml"))
 SYNC_WRITE = 0x83
-
-
-def crc16(data: bytes) -> int:
-    crc = 0
-    for byte in data:
-        crc ^= byte << 8
-        for _ in range(8):
-            crc = ((crc << 1) ^ 0x8005) if crc & 0x8000 else (crc << 1)
-            crc &= 0xFFFF
-    return crc
-
-
-def parse_packet(raw: bytes, protocol: float):
-    """(id, instruction, params) of one instruction packet; raises AssertionError if malformed."""
-    if protocol == 2.0:
-        assert raw[:4] == b"\xff\xff\xfd\x00", raw.hex()
-        length = raw[5] | raw[6] << 8
-        assert len(raw) == 7 + length, raw.hex()
-        assert crc16(raw[:-2]) == (raw[-2] | raw[-1] << 8), f"bad CRC {raw.hex()}"
-        body = raw[7:-2].replace(b"\xff\xff\xfd\xfd", b"\xff\xff\xfd")  # unstuff
-        return raw[4], body[0], body[1:]
-    assert raw[:2] == b"\xff\xff", raw.hex()
-    length = raw[3]
-    assert len(raw) == 4 + length, raw.hex()
-    assert (~sum(raw[2:-1])) & 0xFF == raw[-1], f"bad checksum {raw.hex()}"
-    return raw[2], raw[4], raw[5:-1]
 
 
 def goal_frames(recording: Path, protocol: float, goal_len: int, big_endian: bool):
@@ -104,7 +79,7 @@ def test_dry_run_recording_matches_generate(config_path, tmp_path, capsys):
     ("min_deg = -5.0", "min_deg"),
 ])
 def test_walk_with_bad_config_exits_2_and_sends_nothing(edit, field, tmp_path, capsys):
-    source = (Path(__file__).resolve().parents[1] / "config" / "xl430-biped.toml").read_text()
+    source = (CONFIG_DIR / "xl430-biped.toml").read_text()
     replacement = {'backend = "dynamixel"': 'backend = "herkulex"', "id = 2\n": "id = 1\n",
                    "min_deg = -5.0": "min_deg = 200.0"}[edit]
     assert edit in source
@@ -119,7 +94,7 @@ def test_walk_with_bad_config_exits_2_and_sends_nothing(edit, field, tmp_path, c
 
 
 def test_walk_refuses_a_plan_that_breaks_a_limit(tmp_path, capsys):
-    source = (Path(__file__).resolve().parents[1] / "config" / "xl430-biped.toml").read_text()
+    source = (CONFIG_DIR / "xl430-biped.toml").read_text()
     tight = tmp_path / "tight.toml"
     # knees may bend at most 20 degrees: the walk's knee flexion (crouch 25 degrees) breaks it
     tight.write_text(source.replace("max_deg = 110.0", "max_deg = 20.0"))

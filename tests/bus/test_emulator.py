@@ -7,7 +7,6 @@ scheduled replies are read back, so these tests cost no wall-clock time.
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import select
 import sys
@@ -19,21 +18,13 @@ import pytest
 from gaitbot.servos import wire
 from gaitbot.bus.log import decode_goal_frames
 from gaitbot.servos.models import servo_model
+from gaitbot.bus import emulator as se
+from gaitbot.app import emulator as emulator_cli
+from helpers import REPO_ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
-
-
-def _load_emulator():
-    if "servo_emulator" in sys.modules:
-        return sys.modules["servo_emulator"]
-    spec = importlib.util.spec_from_file_location("servo_emulator", ROOT / "tools" / "servo_emulator.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["servo_emulator"] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+ROOT = REPO_ROOT
 
 
-se = _load_emulator()
 XL430, AX12, STS, SCS = (servo_model(n) for n in ("XL430-W250", "AX-12A", "STS3215", "SCS0009"))
 
 
@@ -268,9 +259,9 @@ def test_hand_from_a_trajectory_file_on_the_command_line(tmp_path):
     walk = generate_walk(leg_geometry(robot), [0.05, 0.05], walk_settings(robot))
     path = tmp_path / "hand.csv"
     walk.save(path)
-    config = se.config_from_args(se.build_parser().parse_args(["--robot", "xl430-biped", "--hand", str(path)]))
+    config = emulator_cli.config_from_args(emulator_cli.build_parser().parse_args(["--robot", "xl430-biped", "--hand", str(path)]))
     assert config.hand.samples == len(walk) and config.hand.rate_hz is None
     # right hip (id 4) is mirror-mounted: ticks = 2048 - deg * 4096 / 360
     assert config.hand.ticks[4][200] == round(2048 - walk.angles_deg[200, 3] * 4096 / 360)
     with pytest.raises(ValueError, match="needs --robot"):
-        se.config_from_args(se.build_parser().parse_args(["--protocol", "dxl2", "--hand", str(path)]))
+        emulator_cli.config_from_args(emulator_cli.build_parser().parse_args(["--protocol", "dxl2", "--hand", str(path)]))

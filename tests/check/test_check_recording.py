@@ -16,7 +16,7 @@ import pytest
 from gaitbot.check.recording import (MAX_GAP_PERIODS, BusIssue, _frame_timing, _motion_samples, check_recording,
                                      match_config, read_log)
 from gaitbot.bus.log import RecordingError
-from test_check_support import (PERIOD_S, ROBOTS, build_sync_write, config, goal_layout, goal_line_indices,
+from helpers import (PERIOD_S, ROBOTS, build_sync_write, config, goal_layout, goal_line_indices,
                                 goal_row_near, read_lines, run_cli, split_sync_write, write_lines)
 
 

@@ -25,8 +25,9 @@ from gaitbot.gait import (TABLE1_LEG, LegGeometry, WalkSettings, generate_walk, 
 from gaitbot.gait.walker import plan_walk, trajectory_of
 from gaitbot.robot.config import load_robot_config
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings
+from helpers import CONFIG_DIR as REPO_CONFIG_DIR
 
-CONFIG_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "config")
+CONFIG_DIR = str(REPO_CONFIG_DIR)
 CONFIG_FILES = sorted(glob.glob(os.path.join(CONFIG_DIR, "*.toml")))
 LEGS = ("left", "right")
 

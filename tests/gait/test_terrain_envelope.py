@@ -9,8 +9,9 @@ from gaitbot.app.cli import main
 from gaitbot.gait.terrain.envelope import REFERENCE_MARGIN_M, StepEnvelope, course_problems
 from gaitbot.gait.terrain.model import Terrain, Tread
 from gaitbot.robot.config import ConfigError, load_robot_config
+from helpers import REPO_ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = REPO_ROOT
 ROBOTS = sorted((ROOT / "config").glob("*.toml"))
 ENV = StepEnvelope.for_foot(0.12, 0.04, 0.035, 0.08, "test leg")
 

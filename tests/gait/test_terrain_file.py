@@ -6,8 +6,9 @@ import pytest
 
 from gaitbot.gait.terrain.model import Terrain, TerrainError, Tread
 from gaitbot.gait.terrain.course_file import TerrainFileError, load_course
+from helpers import CONFIG_DIR
 
-EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "config" / "terrain").glob("*.toml"))
+EXAMPLES = sorted((CONFIG_DIR / "terrain").glob("*.toml"))
 
 
 def test_examples_are_shipped():

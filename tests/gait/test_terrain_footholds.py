@@ -10,9 +10,9 @@ from gaitbot.gait.terrain.envelope import StepEnvelope
 from gaitbot.gait.terrain.footholds import CourseError, FootholdLimits, plan_footholds
 from gaitbot.gait.terrain.model import Terrain, Tread
 from gaitbot.gait.terrain.course_file import load_course
-from terrain_profile import surface_pieces
+from helpers import CONFIG_DIR, surface_pieces
 
-EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "config" / "terrain").glob("*.toml"))
+EXAMPLES = sorted((CONFIG_DIR / "terrain").glob("*.toml"))
 FOOT, MARGIN, FLAT = 0.12, 0.01, 0.10
 RISE, DROP, GAP = 0.045, 0.04, 0.08
 LIMITS = FootholdLimits(FOOT, MARGIN, FLAT, StepEnvelope.for_foot(FOOT, RISE, DROP, GAP, "test leg"))

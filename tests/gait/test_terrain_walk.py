@@ -18,11 +18,11 @@ from gaitbot.gait.terrain.walk import plan_terrain_walk
 from gaitbot.gait.walker import make_context
 from gaitbot.robot.config import load_robot_config
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings
-from gaitbot.app.options import GaitSource, terrain_settings
+from gaitbot.robot.walk_settings import GaitSource, terrain_settings
 from gaitbot.gait.terrain.course_file import Course, load_course
-from terrain_profile import height, surface_pieces
+from helpers import REPO_ROOT, height, surface_pieces
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = REPO_ROOT
 EXAMPLES = ROOT / "config" / "terrain"
 ROBOTS = sorted(p.stem for p in (ROOT / "config").glob("*.toml"))
 TOUCH = 1e-9  # a point this close to the terrain in two consecutive frames is a locked contact

@@ -17,8 +17,8 @@ from gaitbot.app.cli import main
 from gaitbot.robot.config import ConfigError, load_robot_config
 from gaitbot.robot.gains import GainError, gain_for_error, gain_plan
 from gaitbot.servos.models import SERVO_MODELS
+from helpers import CONFIG_DIR
 
-CONFIG_DIR = Path(__file__).resolve().parents[1] / "config"
 XL430, XM430, AX12, STS = (SERVO_MODELS[n] for n in ("XL430-W250", "XM430-W350", "AX-12A", "STS3215"))
 
 

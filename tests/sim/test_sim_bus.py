@@ -22,7 +22,7 @@ from gaitbot.sim.port import SimPort, make_sim_bus  # noqa: E402
 from gaitbot.app.cli import main  # noqa: E402
 from gaitbot.stream.clock import VirtualClock  # noqa: E402
 from gaitbot.robot.config import load_robot_config, resolve_config  # noqa: E402
-from test_sim_model import float_in_air  # noqa: E402
+from helpers import float_in_air  # noqa: E402
 
 ROBOTS = ("xl430-biped", "sts3215-biped", "ax12a-biped")
 

@@ -27,9 +27,8 @@ from gaitbot.sim.port import make_sim_bus  # noqa: E402
 from gaitbot.app.cli import main  # noqa: E402
 from gaitbot.stream.clock import VirtualClock  # noqa: E402
 from gaitbot.robot.config import load_robot_config, resolve_config  # noqa: E402
-from test_sim_model import float_in_air  # noqa: E402
+from helpers import CONFIG_DIR, float_in_air  # noqa: E402
 
-CONFIG_DIR = Path(__file__).resolve().parents[1] / "config"
 KNEE_LEFT = 1  # walking-joint index of knee_pitch_left
 
 

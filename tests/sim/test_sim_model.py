@@ -21,6 +21,7 @@ except SimUnavailable:
 
 from gaitbot.sim.physics import SimRobot  # noqa: E402
 from gaitbot.robot.config import load_robot_config, resolve_config  # noqa: E402
+from helpers import float_in_air  # noqa: E402
 
 ROBOTS = ("xl430-biped", "sts3215-biped", "ax12a-biped")
 KNEE_LEFT = 1  # walking-joint index of knee_pitch_left

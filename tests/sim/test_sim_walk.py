@@ -22,8 +22,8 @@ except SimUnavailable:
     pytest.skip("the sim extra (MuJoCo) is not installed", allow_module_level=True)
 
 from gaitbot.app.cli import main  # noqa: E402
+from helpers import CONFIG_DIR  # noqa: E402
 
-CONFIG_DIR = Path(__file__).resolve().parents[1] / "config"
 ROBOTS = ("xl430-biped", "sts3215-biped", "ax12a-biped")
 KEYS = ("distance_planned_m", "distance_travelled_m", "fell", "fell_at_s", "max_slip_m", "scuff_fraction",
         "max_torque_fraction", "max_tracking_error_deg")

@@ -28,10 +28,9 @@ from gaitbot.stream.record import record_session
 from gaitbot.robot.calibration import tick_limits
 from gaitbot.robot.config import load_robot_config
 from gaitbot.servos.models import SERVO_MODELS
-from gaitbot.app.options import gain_writes
-from test_walk_cli import crc16, parse_packet  # noqa: E402 - the independent decoder
+from gaitbot.robot.gains import gain_writes
+from helpers import CONFIG_DIR, crc16, emulator_for, gaitbot, parse_packet  # noqa: E402 - the independent decoder
 
-CONFIG_DIR = Path(__file__).resolve().parents[1] / "config"
 WRITE = 0x03
 XM, AX, STS = SERVO_MODELS["XM430-W350"], SERVO_MODELS["AX-12A"], SERVO_MODELS["STS3215"]
 #: robot -> (protocol of its framing, torque enable address, [(address, bytes written)] per servo, in order)
@@ -217,8 +216,6 @@ def test_the_limit_guard_passes_settings_on():
 
 @pytest.mark.parametrize("name", sorted(EXPECTED))
 def test_the_emulator_receives_the_gain_registers(name, tmp_path):
-    from test_emulator_e2e import emulator_for, gaitbot
-
     _, _, gains = EXPECTED[name]
     config = load_robot_config(CONFIG_DIR / f"{name}.toml")
     with emulator_for(CONFIG_DIR / f"{name}.toml", tmp_path / "emu.jsonl") as emulator:
