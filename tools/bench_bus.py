@@ -1,7 +1,7 @@
 """Highest frame rate the real bus backends sustain through a pty, beside the wire limits.
 
 For each protocol, 6 and 12 servos: the real DynamixelBus / FeetechBus (vendor SDK PortHandler on
-the emulator's pty, tools/servo_emulator.py on a thread, factory Return Delay Time) sends frames
+the emulator's pty, gaitbot.bus.emulator on a thread, factory Return Delay Time) sends frames
 back to back for ``--seconds``: goal sync writes only, then a sync write plus a read of every
 servo (sync read where the protocol has one). Beside it, the wire limit from the packet sizes
 (gaitbot.bus.budget.frame_budget: 10 bits a byte, plus one return delay per status packet) at
@@ -28,16 +28,15 @@ except ImportError:  # run from a checkout without installing
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
     from gaitbot.bus.budget import frame_budget
 
+from gaitbot.app.emulator import PROTOCOLS
+from gaitbot.bus import emulator as se
 from gaitbot.bus.factory import make_bus
 from gaitbot.servos.models import servo_model
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import servo_emulator as se  # noqa: E402
 
 
 def measure(protocol: str, n_servos: int, read_back: bool, seconds: float) -> float:
     """Frames per second through the emulator's pty."""
-    backend, version, name = se.PROTOCOLS[protocol]
+    backend, version, name = PROTOCOLS[protocol]
     model = servo_model(name)
     models = {i: model for i in range(1, n_servos + 1)}
     with se.ServoEmulator(se.EmulatorConfig(backend, version, models)) as emulator:
@@ -56,7 +55,7 @@ def measure(protocol: str, n_servos: int, read_back: bool, seconds: float) -> fl
 
 
 def wire_limit_hz(protocol: str, n_servos: int, baudrate: int, read_back: bool) -> float:
-    backend, version, name = se.PROTOCOLS[protocol]
+    backend, version, name = PROTOCOLS[protocol]
     return 1.0 / frame_budget(backend, version, name, n_servos, baudrate, read_back).wire_time_s
 
 

@@ -33,7 +33,7 @@ from gaitbot.gait.terrain.walk import plan_terrain_walk, terrain_limits  # noqa:
 from gaitbot.gait.walker import make_context  # noqa: E402
 from gaitbot.robot.config import load_robot_config, resolve_config, shipped_config_names  # noqa: E402
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings  # noqa: E402
-from gaitbot.app.options import GaitSource, terrain_settings  # noqa: E402
+from gaitbot.robot.walk_settings import GaitSource, terrain_settings  # noqa: E402
 from gaitbot.gait.terrain.course_file import Course, load_course  # noqa: E402
 
 DEFAULT_ROBOT = "xl430-biped"

@@ -39,7 +39,7 @@ from gaitbot.gait.terrain.walk import plan_terrain_walk  # noqa: E402
 from gaitbot.gait.walker import make_context  # noqa: E402
 from gaitbot.robot.config import load_robot_config, shipped_config_names, resolve_config  # noqa: E402
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings  # noqa: E402
-from gaitbot.app.options import GaitSource, terrain_settings  # noqa: E402
+from gaitbot.robot.walk_settings import GaitSource, terrain_settings  # noqa: E402
 from gaitbot.gait.terrain.course_file import Course  # noqa: E402
 
 GRID = 0.0025

@@ -274,12 +274,10 @@ class EmulatedChain(MockPort):
 
         p, v2 = frame.params, self.framing == "v2"
         if frame.instruction == wire.INST_READ:
-            address, rest = self._address_and_rest(p)
-            length = rest[0] | (rest[1] << 8 if v2 else 0)
+            address, length, _ = wire.address_length_and_rest(p, self.framing)
             return [frame.packet_id] if frame.packet_id in self.tables and covers(address, length) else []
         if frame.instruction == wire.INST_SYNC_READ:
-            address, rest = self._address_and_rest(p)
-            length, ids = (rest[0] | rest[1] << 8, rest[2:]) if v2 else (rest[0], rest[1:])
+            address, length, ids = wire.address_length_and_rest(p, self.framing)
             return [i for i in ids if i in self.tables] if covers(address, length) else []
         if frame.instruction == INST_BULK_READ and v2:
             return [p[o] for o in range(0, len(p) - 4, 5)

@@ -393,25 +393,18 @@ def decode_goal_frames(path: str | Path, *, allow_partial_last_line: bool = Fals
 
 def _instruction_fields(frame: wire.Frame, framing: str):
     """ids, address, data_length, data, per_id_data of an instruction packet."""
-    params, wide = frame.params, framing == "v2"
-    step = 2 if wide else 1
-
-    def word(i: int) -> int:
-        return params[i] | (params[i + 1] << 8 if wide else 0)
-
-    inst = frame.instruction
-    if inst == wire.INST_SYNC_WRITE and len(params) >= 2 * step:
-        address, length = word(0), word(step)
-        body = params[2 * step:]
-        per_id = {body[o]: bytes(body[o + 1:o + 1 + length]) for o in range(0, len(body) - length, length + 1)}
-        return tuple(per_id), address, length, bytes(body), per_id
-    if inst == wire.INST_SYNC_READ and len(params) >= 2 * step:
-        return tuple(params[2 * step:]), word(0), word(step), b"", {}
-    if inst == wire.INST_READ and len(params) >= 2 * step:
-        return (frame.packet_id,), word(0), word(step), b"", {}
-    if inst == wire.INST_WRITE and len(params) >= step:
-        data = bytes(params[step:])
-        return (frame.packet_id,), word(0), len(data), data, {}
+    params, inst, width = frame.params, frame.instruction, wire.ADDRESS_BYTES[framing]
+    if inst in (wire.INST_SYNC_WRITE, wire.INST_SYNC_READ, wire.INST_READ) and len(params) >= 2 * width:
+        address, length, rest = wire.address_length_and_rest(params, framing)
+        if inst == wire.INST_SYNC_WRITE:
+            per_id = {rest[o]: bytes(rest[o + 1:o + 1 + length]) for o in range(0, len(rest) - length, length + 1)}
+            return tuple(per_id), address, length, bytes(rest), per_id
+        if inst == wire.INST_SYNC_READ:
+            return tuple(rest), address, length, b"", {}
+        return (frame.packet_id,), address, length, b"", {}
+    if inst == wire.INST_WRITE and len(params) >= width:
+        address, data = wire.address_and_rest(params, framing)
+        return (frame.packet_id,), address, len(data), bytes(data), {}
     return (frame.packet_id,), None, None, bytes(params), {}
 
 

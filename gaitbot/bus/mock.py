@@ -157,9 +157,7 @@ class MockPort:
         return [packet_id] if packet_id in self.tables else []
 
     def _address_and_rest(self, params: bytes) -> tuple[int, bytes]:
-        if self.framing == "v2":
-            return params[0] | params[1] << 8, params[2:]
-        return params[0], params[1:]
+        return wire.address_and_rest(params, self.framing)
 
     def _ping(self, frame: wire.Frame) -> None:
         for servo_id in self._targets(frame.packet_id):
@@ -170,8 +168,7 @@ class MockPort:
             self._reply(servo_id, extra)
 
     def _read(self, frame: wire.Frame) -> None:
-        address, rest = self._address_and_rest(frame.params)
-        length = rest[0] | (rest[1] << 8 if self.framing == "v2" else 0)
+        address, length, _ = wire.address_length_and_rest(frame.params, self.framing)
         if frame.packet_id in self.tables:
             self._reply(frame.packet_id, bytes(self.tables[frame.packet_id][address:address + length]))
 
@@ -183,22 +180,14 @@ class MockPort:
             self._reply(frame.packet_id, b"")
 
     def _sync_write(self, frame: wire.Frame) -> None:
-        address, rest = self._address_and_rest(frame.params)
-        if self.framing == "v2":
-            length, body = rest[0] | rest[1] << 8, rest[2:]
-        else:
-            length, body = rest[0], rest[1:]
+        address, length, body = wire.address_length_and_rest(frame.params, self.framing)
         for offset in range(0, len(body) - length, length + 1):
             servo_id = body[offset]
             if servo_id in self.tables:
                 self._store(servo_id, address, body[offset + 1:offset + 1 + length])
 
     def _sync_read(self, frame: wire.Frame) -> None:
-        address, rest = self._address_and_rest(frame.params)
-        if self.framing == "v2":
-            length, ids = rest[0] | rest[1] << 8, rest[2:]
-        else:
-            length, ids = rest[0], rest[1:]
+        address, length, ids = wire.address_length_and_rest(frame.params, self.framing)
         for servo_id in ids:
             if servo_id in self.tables:
                 self._reply(servo_id, bytes(self.tables[servo_id][address:address + length]))

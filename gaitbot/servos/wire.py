@@ -108,6 +108,22 @@ def build_v2(packet_id: int, instruction: int, params: bytes = b"") -> bytes:
     return head + bytes([crc & 0xFF, crc >> 8])
 
 
+def address_and_rest(params: bytes, framing: str) -> tuple[int, bytes]:
+    """(control-table address, the parameters after it) of a READ, WRITE, SYNC READ or SYNC WRITE:
+    the address is 2 bytes, low first, on 2.0 and 1 byte on 1.0 / Feetech."""
+    if framing == "v2":
+        return params[0] | params[1] << 8, params[2:]
+    return params[0], params[1:]
+
+
+def address_length_and_rest(params: bytes, framing: str) -> tuple[int, int, bytes]:
+    """(address, data length, the parameters after them) of a READ, SYNC READ or SYNC WRITE (both fields
+    2 bytes on 2.0, 1 byte on 1.0 / Feetech)."""
+    address, rest = address_and_rest(params, framing)
+    length, rest = address_and_rest(rest, framing) if len(rest) >= (2 if framing == "v2" else 1) else (0, b"")
+    return address, length, rest
+
+
 @dataclass(frozen=True)
 class Frame:
     """One packet split into its fields. ``params`` are unstuffed; for status packets the error
