@@ -4,6 +4,7 @@
     python tools/bench.py gait            # walker: online per frame, offline frames/s, RV solve
     python tools/bench.py stream          # 60 s real-time dry run of the default robot on the mock bus
     python tools/bench.py stream --seconds 10
+    python tools/bench.py session         # CPU per frame of a whole dry-run walk session (virtual clock)
     python tools/bench.py sim             # real-time factor of `gaitbot walk --sim` (the sim extra)
     python tools/bench.py terrain         # 10 stairs planned and generated; grid search on the examples
 
@@ -122,6 +123,34 @@ def bench_stream(seconds: float) -> None:
     print(f"  {verdict} later than half a period ({half * 1e3:.1f} ms): worst {stats.max_lateness_s * 1e3:.3f} ms late")
 
 
+def bench_session(repeats: int = 5) -> None:
+    """CPU per frame of the whole 60 Hz path of a dry run: LimitGuard, goal sync write, the read-back of
+    one servo, the SDK's packet code and the mock chain, on the virtual clock (no waiting)."""
+    from gaitbot.bus.factory import make_robot_bus
+    from gaitbot.robot.calibration import angles_to_ticks, standing_ticks
+    from gaitbot.robot.config import default_config_path, load_robot_config
+    from gaitbot.robot.gains import gain_writes
+    from gaitbot.robot.walk_settings import joint_limits_ticks, leg_geometry, walk_settings
+    from gaitbot.stream.clock import VirtualClock
+    from gaitbot.stream.session import walk_session
+
+    config = load_robot_config(default_config_path())
+    trajectory = generate_walk(leg_geometry(config), [0.8 * config.gait.max_step_m] * 60, walk_settings(config))
+    frames = angles_to_ticks(config, trajectory.angles_rad)
+    velocity, acceleration = joint_limits_ticks(config)
+    per_frame = []
+    for _ in range(repeats):
+        bus = make_robot_bus(config, "mock", dry_run=True)
+        t0 = time.process_time()
+        walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
+                     max_accel_ticks_per_s2=acceleration, period_s=1.0 / config.gait.rate_hz, clock=VirtualClock(),
+                     setup_writes=gain_writes(config))
+        per_frame.append((time.process_time() - t0) / len(frames))
+    print(f"walk session, dry run of {len(frames)} frames ({config.name}, virtual clock; guard, goal sync write, "
+          f"read-back of one servo, SDK and mock chain): CPU per frame best {min(per_frame) * 1e6:.0f} us, "
+          f"median {np.median(per_frame) * 1e6:.0f} us over {repeats} runs")
+
+
 def bench_sim(distance_m: float = 1.0, repeats: int = 3) -> None:
     """Real-time factor of `gaitbot walk --sim`: simulated seconds over wall seconds, for the whole
     command (planning, preflight, model build, the walk through the SDK packet code) and for the
@@ -160,7 +189,7 @@ def bench_sim(distance_m: float = 1.0, repeats: int = 3) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("sections", nargs="*", default=["gait", "stream"], help="gait, stream, sim, terrain")
+    parser.add_argument("sections", nargs="*", default=["gait", "stream"], help="gait, stream, session, sim, terrain")
     parser.add_argument("--seconds", type=float, default=60.0, help="length of the streaming run")
     args = parser.parse_args()
     print(f"machine: {machine()}")
@@ -169,6 +198,8 @@ def main() -> None:
             bench_gait()
         elif section == "stream":
             bench_stream(args.seconds)
+        elif section == "session":
+            bench_session()
         elif section == "sim":
             bench_sim()
         elif section == "terrain":  # tools/bench_terrain.py
@@ -177,7 +208,7 @@ def main() -> None:
 
             bench_terrain.main([])
         else:
-            parser.error(f"unknown section {section!r} (gait, stream, sim, terrain)")
+            parser.error(f"unknown section {section!r} (gait, stream, session, sim, terrain)")
 
 
 if __name__ == "__main__":

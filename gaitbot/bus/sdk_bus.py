@@ -50,36 +50,16 @@ class SdkBus(Bus):
     """A servo chain driven through a vendor SDK's packet handler.
 
     ``port_handler`` replaces the SDK's ``PortHandler(port_name)`` (the mock and the recorder plug in
-    here), so dry runs send exactly the bytes a real run sends.
+    here), so dry runs send exactly the bytes a real run sends. One GroupSyncWrite and one GroupSyncRead
+    per bus, made at open() and re-addressed only when the ids change: the 60 Hz path builds no objects.
 
-    Fault policy (what each failure costs and what it raises):
-
-    * Reads (present position, sync read or one by one) are retried ``retries`` more times after
-      the first attempt (default 3, so 4 attempts), because one lost or damaged status packet
-      must not end a walk. Each attempt waits at most the SDK's reply timeout (2 x 16 ms USB
-      latency + 2 ms + the packet's bytes at the baud rate: about 34 ms at 1 Mbaud, 50 ms for a
-      6-servo sync read at 57,600 baud). After an attempt in which a servo stayed silent the bus
-      listens ``LATE_REPLY_WATCH_MS`` more for that servo's status packet. All attempts failing
-      raises ``ServoTimeout`` (silent), or ``CorruptReplies`` (every reply had a bad checksum/CRC),
-      naming the servo.
-    * A reply that arrives after its timeout raises ``ServoLate`` at once, without retrying: late
-      answers cannot be matched to questions any more.
-    * A status packet with error bits (overload, overheating, input voltage, ...) raises
-      ``ServoStatusError`` at once, naming the servo and the fault in words. On Dynamixel 2.0 the
-      Hardware Error Status register is read once to say which hardware error the Alert bit means.
-      When torque is being switched off, error bits are recorded but not raised (the servo did
-      take the write).
-    * Any OS-level failure of the port (the adapter unplugged, the pty closed) raises
-      ``PortError`` at once; nothing is retried on a dead port. Writes time out after
-      ``WRITE_TIMEOUT_S`` instead of blocking.
-    * Torque and register writes (``set_torque``, ``write_register``) wait for each servo's status
-      packet and are retried like reads (rewriting the same bytes is harmless); all attempts silent
-      raise ``ServoTimeout`` naming the servo and the address.
-    * Goal writes are never retried: a goal sync write has no status packet to tell success from
-      loss, and the next frame supersedes it anyway.
-
-    So a read costs at most ``(1 + retries) x (reply timeout + LATE_REPLY_WATCH_MS)`` per servo
-    read on its own (sync reads: per call), about 0.3 s at 1 Mbaud with the defaults.
+    Fault policy (docs/bus-faults.md has the whole of it): reads are retried ``retries`` more times
+    (one lost status packet must not end a walk) and, after a silent attempt, the bus listens
+    ``LATE_REPLY_WATCH_MS`` for a late reply; all attempts failing raises ``ServoTimeout`` or
+    ``CorruptReplies`` naming the servo. A late reply raises ``ServoLate`` and error bits raise
+    ``ServoStatusError`` at once; a dead port raises ``PortError`` at once and writes time out after
+    ``WRITE_TIMEOUT_S``. Torque and register writes wait for each status packet and are retried like
+    reads; goal writes are never retried (no status packet, and the next frame supersedes them).
     """
 
     family = ""  # "dynamixel" or "feetech", set by subclasses

@@ -1,43 +1,17 @@
-"""Limit checking of a recorded bus run (a ``gaitbot-bus-log`` JSON Lines file).
+"""Limit checking of a recorded bus run (a ``gaitbot-bus-log`` JSON Lines file, read by gaitbot.bus.log).
 
-A recording is checked in two layers:
+A recording is checked in two layers: **the bus** (every packet well formed, every goal frame
+addressing exactly the configured ids, no unknown ids, the regularity of the goal frames against the
+configured rate: a gap over ``MAX_GAP_PERIODS`` periods left the servos without a new goal that long)
+and **the joints** (the goal ticks decoded back to angles and put through the very same
+``check_trajectory`` as a trajectory file, at the recorded send times).
 
-* **the bus**: every packet well formed (checksum/CRC, framing, hex), every goal frame addressing
-  exactly the configured ids, no unknown ids anywhere, and the regularity of the goal frames
-  (mean, p99 and worst gap against the configured rate);
-* **the joints**: the goal ticks decoded back to angles and put through the very same
-  ``check_trajectory`` as a trajectory file (position, tick range, wrap seam, velocity,
-  acceleration), at the recorded send times.
-
-Choices:
-
-* Robot: ``--robot`` if given; otherwise the header's ``robot`` name if a shipped config of that
-  name exists; otherwise exit 2 asking for ``--robot``. The config must match the recording (joint
-  names and ids, servo models, backend and protocol) or the file is rejected (exit 2): the checks
-  would be meaningless against another robot. A different baud rate or robot name is a warning.
-* Which goal writes count: all goal-position sync writes, in file order. ``walk_session`` writes
-  its first goal (the first pose, or the present pose when a start ramp follows) before torque on,
-  on the same deadline grid as every later frame, and the ramp, walk and stop share that grid; so
-  the goal writes of a session form one series at the configured rate, with no pauses.
-* Frame timing: the gap between consecutive streamed goal writes must not exceed
-  ``MAX_GAP_PERIODS`` (1.5) periods of ``gait.rate_hz`` -- a frame more than half a period late
-  left the servos without a new goal for that long. Time going backwards is an error too. Short
-  gaps are not errors: each phase (ramp, walk, stop) starts its own clock, so its first frame
-  follows the previous phase's last one almost at once.
-* Motion at the recorded times: a goal write at the same time as (or earlier than) the previous
-  one supersedes it for velocity and acceleration (a virtual-clock dry run logs phase boundaries at
-  one instant). A corrupted goal write is ignored by the servos, so it is left out of the motion
-  (but still counts as a frame for timing: the byte went out on time). A joint missing from a frame
-  keeps its previous goal, which is what the servo does.
-* Settings: WRITE packets to other registers than goal and torque (the servos' gain registers a
-  session writes before torque on, gaitbot/recorded_settings.py) are accepted like any well-formed
-  packet to a configured id, and listed in the report ("settings written").
-* Packets: a malformed packet, tx or rx, is an error (exit 1) naming line, time and bytes -- it is a
-  fault of the run, not an unreadable file. A status packet reporting a servo error is a warning.
-  An unparseable JSON line, a line without t/dir/hex, a missing header and a truncated last line
-  (no newline) are unreadable input (exit 2). ``allow_partial_last_line=True`` (``gaitbot check
-  --allow-partial``, ``tools/check_trajectory.py --allow-partial``) instead drops that one line with a
-  warning, for checking the recording of a crashed run.
+Choices, written out in docs/checking.md: the robot is ``--robot`` or the shipped config the header
+names, and must match the recording (else exit 2); all goal sync writes form one series (a session
+keeps one deadline grid from its first goal on); a goal write at the same time as the one before
+supersedes it; a corrupted goal write counts for timing but not for motion; a joint missing from a
+frame keeps its goal; other WRITE packets are settings (gaitbot/check/settings.py). A malformed packet
+is a fault of the run (exit 1); an unreadable file is exit 2.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Boulic's free-walking model (seed 000 section 2.1; keyframes per gait-model.md section 2).
+"""Boulic's free-walking model (seed 000 section 2.1; keyframes per docs/gait-model.md section 2).
 
 Global level: relative velocity RV (speed / leg length) sets the cycle's relative length and
 phase durations. Joint level: hip, knee and ankle angles over a leg's own phase, given by

@@ -2,7 +2,7 @@
 
 Seed 000 section 2.2 locks the supporting foot's heel, then its toe once the foot is parallel
 to the ground, and moves the root by the contact point's displacement (eq. 9). Using "the lower
-of heel and toe is the contact" (gait-model.md section 3), that incremental rule has a closed
+of heel and toe is the contact" (docs/gait-model.md section 3), that incremental rule has a closed
 form: a foot rolling without slip is fixed by one number, its *anchor* (the heel's x when the
 sole is flat), and its pitch. Heel down (pitch >= 0): heel at (anchor, 0). Toe down: toe at
 (anchor + foot, 0). Both agree when flat, so the contact switch never jumps, and the root is

@@ -3,7 +3,7 @@
 A walk made by the walker carries its root and heel strikes; a motion made some other way does
 not: cycles synthesised from an eigen-gait model, or a motion recorded from the robot while a
 person moves its legs. This module recovers both from the angles with the walker's own contact
-model (contact.py, gait-model.md section 3), so such motions obey the same ground rules.
+model (contact.py, docs/gait-model.md section 3), so such motions obey the same ground rules.
 
 - ``ContactRoot``: frame by frame (a recording is written as it is read), the root that keeps the
   supporting foot still. The supporting foot is the one whose lowest sole point is lower; it stays

@@ -1,7 +1,7 @@
 """Leg geometry and planar kinematics of one leg (sagittal plane, x forward, y up).
 
 Hip at the origin. Thigh direction is angle h from the downward vertical, shank h - k, foot
-(h - k) + a from the horizontal, toe up positive (gait-model.md section 1). The foot is a
+(h - k) + a from the horizontal, toe up positive (docs/gait-model.md section 1). The foot is a
 rigid sole: heel and toe are points on it, given relative to the ankle in the foot's frame.
 """
 

@@ -14,7 +14,7 @@ The style (foot path shape, sole pitch, timing) is the model's; the straight sta
 to the crouch, which the walk reaches from standing (and leaves for standing) in joint space with
 both feet flat.
 
-Within a step (gait-model.md section 3, "what the papers do not say"), foot poses relative to
+Within a step (docs/gait-model.md section 3, "what the papers do not say"), foot poses relative to
 the hip are corrected where contact geometry demands it:
 - stance foot: the model's, plus a correction that fades out over the first half of the step
   (it absorbs the landing pose and velocity) and one that fades in over the second half and

@@ -1,4 +1,4 @@
-"""Step length of the Boulic model and its inverse (seed 000 sections 2.3 and 4 of gait-model.md).
+"""Step length of the Boulic model and its inverse (seed 000 sections 2.3 and 4 of docs/gait-model.md).
 
 The realised step length is the distance between consecutive heel-strike points in the world.
 With the supporting foot rolling heel-then-toe without slipping, it follows exactly from the

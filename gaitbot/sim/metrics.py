@@ -4,7 +4,7 @@ What the plan promised (distance, when each foot swings) is handed in by the com
 :class:`WalkPlan`; this module never looks at the gait. Times are simulated seconds from the
 first goal (the walk's first frame: the robot starts in it, standing).
 
-Definitions (the README repeats them):
+Definitions (docs/simulation.md repeats them):
 
 distance_planned_m / distance_travelled_m
     Forward displacement of the hip point (the torso on its boom): planned by the gait, and

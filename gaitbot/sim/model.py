@@ -8,7 +8,7 @@ touch the floor, never each other.
 Legs (``[geometry]``, the numbers the gait's LegGeometry is made of, so the feet are where the gait
 thinks they are): thigh and shank capsules, and a foot whose sole is a box from the heel
 (heel_back_m behind the ankle) to the toe (foot_m ahead of the heel), its underside ankle_height_m
-below the ankle axis. (The bus room reads the robot config only, never the gait room.)
+below the ankle axis. (The sim room reads the robot config only; the gait's plan comes in through walk.py.)
 Hinge axes follow the flexion-positive convention: hip and ankle about -y, knee about +y.
 
 Masses (``[mass]``): torso, thigh, shank, foot; inertias follow from each link's shape as a
@@ -21,7 +21,7 @@ proportional position loop, which is what these servos are:
     torque = clip(kp * (goal - angle), -stall, +stall) - b * speed,    b = stall / no_load_speed
 
 kp = stall torque / full-torque error. The model starts at the factory gain (ServoModel.full_torque_error_deg);
-what the session writes to a servo's gain register then sets it (sim_bus.py reads the register, the
+what the session writes to a servo's gain register then sets it (port.py reads the register, the
 robot's ``set_full_torque_error``), so ``[servo] full_torque_error_deg`` reaches the simulated robot only
 through the packets a real robot would get. ``[servo]`` stall torque and no-load speed override the
 datasheet figures. The back-EMF term b * speed is the joint's damping: it gives the datasheet no-load speed
@@ -34,7 +34,7 @@ Contacts: stiff, because MuJoCo's soft defaults (solref 0.02 s, solimp 0.9/0.95,
 the feet creep under sideways load: measured here, 1.5 mm in 2 s under a push of 0.3 m g (and a
 0.2 mm sink), which would read as slip that a rubber sole on a hard floor does not have. We use
 solref 0.004 s (critically damped) with solimp (0.95, 0.99, 1 mm) and elliptic friction cones with
-impratio 10 (stiff friction): 0.015 mm of creep and a 0.004 mm sink (tests/test_sim_model.py).
+impratio 10 (stiff friction): 0.015 mm of creep and a 0.004 mm sink (tests/sim/test_sim_model.py).
 Sliding friction 1.0 (a rubber sole on a hard floor). Timestep: a frame is cut into whole steps
 of at most 1 ms (MuJoCo wants solref's time constant >= 2 timesteps; here 4); halving it changes
 the walks' distances by under 0.5%.

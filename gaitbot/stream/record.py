@@ -1,34 +1,17 @@
 """Recording a motion a person makes with the robot's legs: torque off, present positions read at the frame rate.
 
-This module knows servo ids, ticks, a :class:`~gaitbot.bus.base.Bus` and a clock (the stream
-room's vocabulary); what a sample becomes (angles, a root, a CSV row) is the ``sink``'s business
-(gaitbot/record_command.py), so data still flows one way inside each room.
+This module knows servo ids, ticks, a :class:`~gaitbot.bus.base.Bus` and a clock (the stream room's
+vocabulary); what a sample becomes (angles, a root, a CSV row) is the ``sink``'s business
+(gaitbot/app/record.py). Sequence (:func:`record_session`): open, ping and read every servo (a missing
+one stops here, nothing written), ask ``confirm(n)`` (a refusal sends nothing), open the sink, torque
+off, then read every present position on the streamer's absolute-deadline grid
+(:func:`gaitbot.stream.pacing.paced_deadlines`) and hand each sample to ``sink.add(t_s, ticks)``.
 
-Sequence (:func:`record_session`): open the bus -> ping every servo and read where they are
-(:func:`gaitbot.stream.session.prepare`; a missing servo stops here, nothing written) -> ask
-``confirm(n)`` (a refusal ends here: nothing sent, torque as it was, no file) -> ``sink.open()``
--> torque off on every servo -> read every servo's present position (sync read where the
-protocol has one) on the absolute-deadline grid of the streamer (:func:`gaitbot.stream.pacing.paced_deadlines`:
-sample k due at ``k * period``, never re-anchored, never skipped, never in a burst) and hand each
-sample to ``sink.add(t_s, ticks)`` with ``t_s = k * period`` -> end.
-
-Ways out, and the state each leaves (the torque is off throughout the recording, since a hand
-moves the legs):
-
-* completed (exit 0): ``n_samples`` read;
-* stopped (exit 0): Ctrl-C, the usual way to end a recording without ``n_samples``;
-* terminated (exit 143): SIGTERM;
-* bus_error (exit 1): a servo stops answering, reports an error, or the port disappears;
-* file_error (exit 1): the sink cannot write (a full disk); the rows before are in the file.
-
-Torque stays off at every exit (the person holding the legs keeps them). With ``hold_at_end``,
-after a completed, stopped or terminated recording the pose is held instead: present positions
-are read once more, the session's settings are written (``setup_writes``: the servos' gains, as a
-walk writes them), the pose is written as goals (through the caller's LimitGuard, which refuses a
-pose outside the joint limits) and torque goes on, in that order, as a walk starts. If any of that
-fails, torque goes off again on every servo and a note says why. After a bus error nothing more
-is tried beyond the torque-off that is already in place. ``sink.close()`` and ``bus.close()``
-run in a ``finally``, so every sample read is in the file whatever happens.
+Ways out: completed or stopped by Ctrl-C (0), terminated (143), bus_error (1), file_error (1: the
+sink cannot write). Torque stays off at every exit (the person holding the legs keeps them) unless
+``hold_at_end``: the pose is then read once more, the settings written, the pose written as goals
+(through the caller's LimitGuard) and torque turned on, in the order a walk starts; any failure there
+turns torque off again. docs/recording.md has the whole story.
 """
 
 from __future__ import annotations

@@ -106,43 +106,20 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
                  setup_writes: Sequence[RegisterWrite] = ()) -> SessionResult:
     """Open, check, ramp to the first pose, walk, and leave the robot in a known pose.
 
-    Sequence: ``bus.open()`` -> :func:`prepare` (ping all, read present) -> ``setup_writes``
-    (:func:`write_settings`: the servos' gains; none leaves them as they are) -> write present
-    as goal, then torque on (a servo enabled with a stale goal register would jump to it)
-    -> ramp from present to ``frames[0]`` -> stream ``frames`` -> end.
+    Sequence: ``bus.open()`` -> :func:`prepare` (ping all, read present) -> ``setup_writes`` (the
+    servos' gains) -> present pose as goal, then torque on (a servo enabled with a stale goal register
+    would jump to it) -> ramp to ``frames[0]`` -> stream ``frames`` -> end. Ways out (completed 0,
+    interrupted 130, terminated 143, bus_error 1) and the safe stop (brake at the acceleration limit
+    from the motion under way, then ramp to ``stand_ticks``) are in docs/bus-faults.md; in every case
+    torque goes off if ``torque_off_on_exit`` and the bus is closed in a ``finally`` (which flushes a
+    recording). A PortError (the port is gone) skips the stop ramp and the torque-off: nothing could
+    reach the servos.
 
-    Ways out:
-      * completed (0): the trajectory should end standing. If its last frame is not
-        ``stand_ticks``, a final ramp takes the robot there.
-      * interrupted (130, Ctrl-C) / terminated (143, SIGTERM): streaming stops; the safe
-        stop (:func:`~gaitbot.stream.ramps.stop_ticks`) brakes the motion under way at the
-        acceleration limit, then ramps to ``stand_ticks`` within the limits. A second
-        Ctrl-C or SIGTERM during it abandons it.
-      * bus_error (1): one attempt at the ramp to stand. The first failing bus call ends it,
-        so a dead bus costs one bounded timeout, never a hang. The error is in ``error``.
-        When the error is a :class:`~gaitbot.bus.base.PortError` (the port itself is gone),
-        nothing can reach the servos: no stop ramp and no torque-off are tried, the servos hold
-        their last goal, and a note says so.
-
-    Servo faults during motion: with ``monitor_servos`` (the default) every frame of the start
-    ramp, the walk and the final ramp is followed by a read-back of one servo, each in turn
-    (``bus.read_present_ticks``), so that a servo that stops answering, answers late, sends
-    damaged packets or reports error bits (overload, overheating, input voltage) raises a
-    BusError naming it within ``len(ids)`` frames plus the bus's bounded retries. The bus retries reads as its fault policy says
-    (see :class:`gaitbot.bus.sdk_bus.SdkBus`). The safe stop ramp is not read back: it must
-    reach the healthy servos whatever the faulty one does.
-    In every case, torque goes off if ``torque_off_on_exit``, and the bus is closed in a
-    ``finally`` so that a recording made by the bus is flushed and readable. Other
-    exceptions (bugs) get the same safe stop and are then re-raised.
-
-    The stop starts from the motion under way: velocity from the last two frames sent.
-    Braking each joint at the acceleration limit overshoots the last pose by v^2 / (2 a),
-    which a trajectory checked against the same limits always has room for. Stopping dead
-    at the last pose would decelerate at v / period instead, several times the limit at
-    walking speeds.
-
-    handle_sigterm: install a SIGTERM handler that raises :class:`Terminated` (main
-    thread only; the previous handler is restored on return).
+    ``monitor_servos``: after every frame of the start ramp, the walk and the final ramp one servo is
+    read back, each in turn, so a servo that stops answering or reports error bits ends the walk within
+    ``len(ids)`` frames plus the bus's bounded retries; the safe stop ramp is not read back (it must
+    reach the healthy servos whatever the faulty one does). ``handle_sigterm``: SIGTERM raises
+    :class:`~gaitbot.stream.signals.Terminated` (main thread only; the old handler is restored).
     """
     ids = [int(i) for i in ids]
     walk = as_tick_frames(frames, len(ids))

@@ -1,7 +1,7 @@
-"""Boulic model, step length and its inverse, Bezier blending (gait-model.md sections 2, 4, 5).
+"""Boulic model, step length and its inverse, Bezier blending (docs/gait-model.md sections 2, 4, 5).
 
 Expected values come from seed 000 (Table 3; Appendix A's Hermite blend), from the keyframe table
-of gait-model.md section 2 (written out again here, independently of gaitbot.gait.boulic), and from
+of docs/gait-model.md section 2 (written out again here, independently of gaitbot.gait.boulic), and from
 hand computation.
 """
 
@@ -32,7 +32,7 @@ def inverse():
 
 
 # --------------------------------------------------------------------------------------------
-# the keyframe table of gait-model.md section 2, written out independently
+# the keyframe table of docs/gait-model.md section 2, written out independently
 # --------------------------------------------------------------------------------------------
 def table_keyframes(rv: float, ds_dc: float) -> dict:
     if rv < 0.5:
@@ -94,7 +94,7 @@ def my_step_length(rv: float, g: LegGeometry = TABLE1_LEG) -> float:
 # 1. Table 3 and the inverse
 # --------------------------------------------------------------------------------------------
 def test_toe_off_phase_with_table2_cycle():
-    """Ds/Dc = (0.752 * 1.346 - 0.143) / 1.346 = 0.64576 (gait-model.md: 0.6458)."""
+    """Ds/Dc = (0.752 * 1.346 - 0.143) / 1.346 = 0.64576 (docs/gait-model.md: 0.6458)."""
     assert toe_off_phase(DC) == pytest.approx(0.6458, abs=1e-4)
 
 

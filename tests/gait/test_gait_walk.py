@@ -1,6 +1,6 @@
 """Whole walks checked from the outside: only the emitted joint angles and root are used.
 
-The forward kinematics below is written here from gait-model.md section 1, independently of
+The forward kinematics below is written here from docs/gait-model.md section 1, independently of
 gaitbot.gait.geometry: thigh direction h from the downward vertical, shank h - k, sole pitch
 (h - k) + a from the horizontal (toe up positive); the sole lies ``ankle_height`` below the ankle,
 perpendicular to the sole; the heel is ``heel_back`` behind the ankle's projection on the sole

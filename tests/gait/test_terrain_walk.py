@@ -1,4 +1,4 @@
-"""Terrain walks judged from the emitted angles and root alone (own forward kinematics, gait-model.md
+"""Terrain walks judged from the emitted angles and root alone (own forward kinematics, docs/gait-model.md
 section 1, and an own terrain profile built from the treads): no foot point under the terrain, locked
 contacts still, footholds on one tread with their margin, swing clearance over every edge, joint
 position, velocity and acceleration limits, continuous joint velocities at every switch between the

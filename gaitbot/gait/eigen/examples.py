@@ -1,6 +1,6 @@
 """Example cycles from trajectory files (seed 004 section 3: cycle segmentation).
 
-A cycle runs from a left heel strike to the next left heel strike (two steps, gait-model.md
+A cycle runs from a left heel strike to the next left heel strike (two steps, docs/gait-model.md
 section 1). Trajectory ``.npz`` files carry their heel strikes; CSV files (and recordings) do not,
 so heel strikes are detected from foot contact with forward kinematics (gait/footfall.py, the rule
 ``gaitbot plot`` uses too): a leg's foot is in the air while its lowest sole point is more than

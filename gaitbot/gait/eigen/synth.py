@@ -1,5 +1,5 @@
 """From eigen-gait coefficients to a walk: cycles in real time, joined to a start and a stop, and the
-root from foot contact (seed 004 section 6; gait-model.md section 3).
+root from foot contact (seed 004 section 6; docs/gait-model.md section 3).
 
 Choices (stated once):
 - The model only knows steady cycles (left heel strike to left heel strike). A walk therefore
