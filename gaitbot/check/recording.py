@@ -16,7 +16,6 @@ is a fault of the run (exit 1); an unreadable file is exit 2.
 
 from __future__ import annotations
 
-import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
 

@@ -11,8 +11,6 @@ walk per fault, which stops within about a second of the fault.
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 import time
 from pathlib import Path
 

@@ -15,7 +15,7 @@ import pytest
 from gaitbot.app.cli import main
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.config import load_robot_config
-from helpers import CONFIG_DIR, crc16, parse_packet
+from helpers import CONFIG_DIR, parse_packet
 
 CONFIGS = sorted(CONFIG_DIR.glob("*.toml"))
 SYNC_WRITE = 0x83

@@ -9,9 +9,7 @@ from __future__ import annotations
 
 import os
 import select
-import sys
 import time
-from pathlib import Path
 
 import pytest
 

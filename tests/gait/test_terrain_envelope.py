@@ -1,7 +1,6 @@
 """The step envelope: the robot configs carry it, the planner and the course check share it, and a course
 outside it is refused up front naming the tread and why (exit 2, one line); a course inside it plans."""
 
-from pathlib import Path
 
 import pytest
 

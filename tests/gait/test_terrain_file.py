@@ -1,6 +1,5 @@
 """Terrain files: the shipped examples load; every mistake is one line naming the file and the field."""
 
-from pathlib import Path
 
 import pytest
 

@@ -1,7 +1,6 @@
 """Foothold planner: each foot fully on one tread with its margin, steps and swings within the leg's
 envelope, and a clear error saying where and why when the course cannot be walked."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -40,13 +40,6 @@ def sole_corners(robot: SimRobot, side: int) -> dict[str, np.ndarray]:
             "toe": centre + rot @ np.array([half[0], 0.0, -half[2]])}
 
 
-def float_in_air(robot: SimRobot) -> None:
-    """Lift the robot off the floor and switch gravity off: only the servos act on the legs."""
-    robot.model.opt.gravity[:] = 0.0
-    robot.data.qpos[robot.model.joint("boom_z").qposadr[0]] = 0.5
-    robot.mujoco.mj_forward(robot.model, robot.data)
-
-
 @pytest.mark.parametrize("name", ROBOTS)
 def test_standing_soles_lie_on_the_floor_where_the_config_puts_them(name):
     robot = robot_of(name)
