@@ -1,4 +1,4 @@
-"""The gait room: pure numpy, no I/O but the Trajectory file format.
+"""The gait room: pure numpy, no I/O but the trajectory file format and the terrain course reader.
 
 Entry points: ``generate_walk`` (offline, whole trajectory), ``OnlineWalker`` (frame by frame),
 ``StepLengthInverse`` (step length <-> RV), ``steps_for_distance`` and ``perturb_steps``.

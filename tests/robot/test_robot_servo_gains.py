@@ -3,7 +3,7 @@
 Dynamixel X (e-Manual "Position PID Gain"): KPP = Position P Gain / 128 drives PWM, full at the PWM
 Limit 885, so full output at 885 / KPP pulses; 4096 pulses a turn. AX-12A (e-Manual "Compliance
 Slope"): steps 2, 4, ..., 128, full output beyond slope x 300/1023 deg. Feetech STS3215: P = 32 at the
-X series' factory 12.4 deg (an assumption, written down in servo_models.py), P proportional to 1/error.
+X series' factory 12.4 deg (an assumption, written down in gaitbot/servos/models.py), P proportional to 1/error.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The simulated robot's model checked from outside: geometry, masses, servo behaviour, contacts.
 
-Expected values come from the robot configs and the servo datasheet figures (servo_models), not
+Expected values come from the robot configs and the servo datasheet figures (gaitbot.servos.models), not
 from the model builder: sole corners from the leg lengths, speeds from the no-load rpm, deflections
 from stall torque over full-torque error.
 """

@@ -2,7 +2,7 @@
 
 Packets are decoded with test_walk_cli's decoder (written from the protocol documents, not gaitbot's)
 and checksums worked by hand; expected register values come from the datasheet formulas
-(tests/test_robot_servo_gains.py): full torque at 2 deg is Position P Gain 4978 on a Dynamixel X,
+(tests/robot/test_robot_servo_gains.py): full torque at 2 deg is Position P Gain 4978 on a Dynamixel X,
 compliance slope 4 on an AX-12A (the stiffest step not above 2 deg), P coefficient 199 on an STS3215.
 """
 
