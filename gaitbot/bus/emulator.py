@@ -12,6 +12,7 @@ sends (reg write, action, reboot, bulk read/write), faults (silent, late, corrup
 that disappears) and a hand that moves servos whose torque is off. docs/emulator.md describes it;
 gaitbot.app.emulator is its command line.
 """
+
 from __future__ import annotations
 
 import math
