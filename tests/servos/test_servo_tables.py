@@ -14,6 +14,7 @@ from gaitbot.bus.mock import MockPort
 from gaitbot.servos import BACKENDS, VENDORS, control_table, dynamixel, feetech, max_servo_id, wire
 from gaitbot.servos.models import SERVO_MODELS
 from gaitbot.servos.registers import overlaps
+from helpers import crc16 as crc16_bit_by_bit  # the e-Manual's definition, bit by bit
 
 
 def test_one_backend_list():
@@ -65,24 +66,13 @@ def test_sdk_baud_rates_are_the_vendors():
     assert not MockPort("feetech", 1.0, {}).setBaudRate(4_000_000)
 
 
-def _crc_bit_by_bit(data: bytes) -> int:
-    """The e-Manual's definition: polynomial 0x8005, initial 0, MSB first, no final xor."""
-    crc = 0
-    for byte in data:
-        crc ^= byte << 8
-        for _ in range(8):
-            crc = ((crc << 1) ^ 0x8005) if crc & 0x8000 else (crc << 1)
-            crc &= 0xFFFF
-    return crc
-
-
 def test_table_crc_is_the_emanual_crc():
     # e-Manual Protocol 2.0 ping example: FF FF FD 00 01 03 00 01, CRC 19 4E
     assert wire.crc16(bytes.fromhex("FFFFFD0001030001")) == 0x4E19
     rng = random.Random(0)
     for _ in range(500):
         data = bytes(rng.randrange(256) for _ in range(rng.randrange(0, 64)))
-        assert wire.crc16(data) == _crc_bit_by_bit(data)
+        assert wire.crc16(data) == crc16_bit_by_bit(data)
 
 
 def test_addressed_parameters_by_framing():
