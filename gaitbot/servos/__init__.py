@@ -49,5 +49,44 @@ def control_table(model_name: str) -> ControlTable:
     raise KeyError(f"no control table for servo model {model_name!r}")
 
 
+def _vendor_of_model(model_name: str) -> ModuleType:
+    for module in VENDORS.values():
+        if model_name in module.CONTROL_TABLES:
+            return module
+    raise KeyError(f"no control table for servo model {model_name!r}")
+
+
+def baud_rates(model_name: str) -> dict[int, int]:
+    """Baud Rate register value -> bits per second of a servo model (its vendor's table)."""
+    return _vendor_of_model(model_name).BAUD_RATES[model_name]
+
+
+def baud_register_value(model_name: str, baudrate: int) -> int | None:
+    """The Baud Rate register value that sets ``baudrate`` on a model (None: the model cannot run at it)."""
+    for value, rate in baud_rates(model_name).items():
+        if rate == int(baudrate):
+            return value
+    return None
+
+
+def factory_baudrate(model_name: str) -> int:
+    """The baud rate a model leaves the factory at (X series 57,600; AX, XL-320 and Feetech 1,000,000)."""
+    return baud_rates(model_name)[control_table(model_name)["Baud Rate"].factory]
+
+
+def common_baud_rates(backend: str, protocol: float, model_names=None) -> tuple[int, ...]:
+    """The baud rates worth scanning on a ``backend`` bus speaking ``protocol``: every rate the Baud Rate
+    register of a model of that protocol (or of ``model_names``) can hold and the vendor SDK's PortHandler
+    accepts (dynamixel_sdk refuses 4.5 M, 400 k, 250 k, 200 k; scservo_sdk 76,800), fastest first."""
+    module = vendor(backend)
+    from gaitbot.servos.models import SERVO_MODELS  # models is built on this package's tables
+
+    names = model_names or [m.name for m in SERVO_MODELS.values()
+                            if m.family == backend and float(protocol) in m.protocols]
+    rates = {rate for name in names for rate in baud_rates(name).values() if rate in module.SDK_BAUDRATES}
+    return tuple(sorted(rates, reverse=True))
+
+
 __all__ = ["VENDORS", "BACKENDS", "ASSUMED_RETURN_DELAY_S", "ControlTable", "Register", "RegisterWrite", "vendor",
-           "max_servo_id", "has_sync_read", "control_table", "dynamixel", "feetech"]
+           "max_servo_id", "has_sync_read", "control_table", "baud_rates", "baud_register_value", "factory_baudrate",
+           "common_baud_rates", "dynamixel", "feetech"]

@@ -19,47 +19,76 @@ SDK_BAUDRATES = (9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 5760
                  1152000, 2000000, 2500000, 3000000, 3500000, 4000000)
 #: Model numbers returned by ping and stored at "Model Number".
 MODEL_NUMBERS = {"XL430-W250": 1060, "XM430-W350": 1020, "XL-320": 350, "AX-12A": 12}
-#: Firmware version a Protocol 2.0 ping reply carries in the mock chain.
-PING_FIRMWARE_VERSION = 45
+#: Every Dynamixel leaves the factory at id 1 (e-Manual Protocol 1.0 / 2.0, "ID": "the default ID ... is 1").
+FACTORY_ID = 1
 
-# X series (XL430-W250, XM430-W350), e-Manual control tables; factory values as shipped.
+# Control tables from the e-Manual (ROBOTIS-GIT/emanual docs/en/dxl/x/xl430-w250.md, xm430-w350.md,
+# xl320.md, ax/ax-12a.md; /work/proto/facts/vendor-facts.md section 2). ``factory`` is the value as shipped
+# for settings; for the Present registers it is the value the emulator starts from (not a vendor fact).
+# X series (XL430-W250, XM430-W350): EEPROM 0..63, RAM from 64 (EEPROM writable only with torque off).
 _X_SERIES: ControlTable = {
-    "Model Number": Register(0, 2), "Firmware Version": Register(6, 1, 46), "ID": Register(7, 1),
-    "Baud Rate": Register(8, 1, 3), "Return Delay Time": Register(9, 1, 250), "Operating Mode": Register(11, 1, 3),
+    "Model Number": Register(0, 2), "Firmware Version": Register(6, 1, 46), "ID": Register(7, 1, FACTORY_ID),
+    # Baud Rate(8): factory 1 = 57,600 bps (e-Manual "Baud Rate(8)", initial value 1)
+    "Baud Rate": Register(8, 1, 1), "Return Delay Time": Register(9, 1, 250), "Operating Mode": Register(11, 1, 3),
     "Protocol Type": Register(13, 1, 2), "Temperature Limit": Register(31, 1, 72),
     "Max Voltage Limit": Register(32, 2, 140), "Min Voltage Limit": Register(34, 2, 60),
     "Max Position Limit": Register(48, 4, 4095), "Min Position Limit": Register(52, 4, 0),
     "Shutdown": Register(63, 1, 0x34), "Torque Enable": Register(64, 1), "Status Return Level": Register(68, 1, 2),
     "Hardware Error Status": Register(70, 1), "Position P Gain": Register(84, 2),
     "Profile Velocity": Register(112, 4), "Goal Position": Register(116, 4), "Moving": Register(122, 1),
-    "Present Position": Register(132, 4), "Present Input Voltage": Register(144, 2, 120),
-    "Present Temperature": Register(146, 1, 30),
+    # Present Load(126): signed, 0.1 % of the maximum torque, positive = CCW (e-Manual "Present Load(126)")
+    "Present Load": Register(126, 2, 0), "Present Position": Register(132, 4),
+    "Present Input Voltage": Register(144, 2, 120), "Present Temperature": Register(146, 1, 30),
 }
-# Factory Position P Gain: XL430-W250 640 (with Position D Gain 4000), XM430-W350 800.
+# XL430-W250: Temperature Limit 72 C, voltage limits 14.0 / 6.0 V, Position P Gain 640 (with D 4000).
 XL430_W250: ControlTable = {**_X_SERIES, "Position P Gain": Register(84, 2, 640)}
-XM430_W350: ControlTable = {**_X_SERIES, "Position P Gain": Register(84, 2, 800)}
+# XM430-W350: Temperature Limit 80 C, voltage limits 16.0 / 9.5 V, Position P Gain 800; address 126 is
+# Present Current (2.69 mA a unit), not a load, so it is left out of its table.
+XM430_W350: ControlTable = {
+    **{name: r for name, r in _X_SERIES.items() if name != "Present Load"},
+    "Temperature Limit": Register(31, 1, 80), "Max Voltage Limit": Register(32, 2, 160),
+    "Min Voltage Limit": Register(34, 2, 95), "Position P Gain": Register(84, 2, 800)}
+# XL-320 (Protocol 2.0 only): EEPROM 0..18, RAM from 24; Present Load(41) bit 10 = direction, 0.1 %.
 XL_320: ControlTable = {
-    "Model Number": Register(0, 2), "Firmware Version": Register(2, 1, 30), "ID": Register(3, 1),
+    "Model Number": Register(0, 2), "Firmware Version": Register(2, 1, 30), "ID": Register(3, 1, FACTORY_ID),
     "Baud Rate": Register(4, 1, 3), "Return Delay Time": Register(5, 1, 250), "CCW Angle Limit": Register(8, 2, 1023),
     "Control Mode": Register(11, 1, 2), "Temperature Limit": Register(12, 1, 65),
     "Min Voltage Limit": Register(13, 1, 60), "Max Voltage Limit": Register(14, 1, 90),
     "Max Torque": Register(15, 2, 1023), "Status Return Level": Register(17, 1, 2), "Shutdown": Register(18, 1, 3),
     "Torque Enable": Register(24, 1), "P Gain": Register(29, 1), "Goal Position": Register(30, 2),
-    "Moving Speed": Register(32, 2), "Present Position": Register(37, 2), "Present Voltage": Register(45, 1, 74),
-    "Present Temperature": Register(46, 1, 30), "Moving": Register(49, 1), "Hardware Error Status": Register(50, 1),
+    "Moving Speed": Register(32, 2), "Present Position": Register(37, 2), "Present Load": Register(41, 2, 0),
+    "Present Voltage": Register(45, 1, 74), "Present Temperature": Register(46, 1, 30), "Moving": Register(49, 1),
+    "Hardware Error Status": Register(50, 1),
 }
+# AX-12A (Protocol 1.0): EEPROM 0..18, RAM from 24; no Hardware Error Status register (errors come in every
+# status packet's error byte); Present Load(40) bits 0..9 magnitude in 0.1 %, bit 10 = direction (1 = CW).
 AX_12A: ControlTable = {
-    "Model Number": Register(0, 2), "Firmware Version": Register(2, 1, 24), "ID": Register(3, 1),
+    "Model Number": Register(0, 2), "Firmware Version": Register(2, 1, 24), "ID": Register(3, 1, FACTORY_ID),
     "Baud Rate": Register(4, 1, 1), "Return Delay Time": Register(5, 1, 250), "CCW Angle Limit": Register(8, 2, 1023),
     "Temperature Limit": Register(11, 1, 70), "Min Voltage Limit": Register(12, 1, 60),
     "Max Voltage Limit": Register(13, 1, 140), "Max Torque": Register(14, 2, 1023),
     "Status Return Level": Register(16, 1, 2), "Alarm LED": Register(17, 1, 0x24), "Shutdown": Register(18, 1, 0x24),
     "Torque Enable": Register(24, 1), "CW Compliance Slope": Register(28, 1, 32),
     "CCW Compliance Slope": Register(29, 1, 32), "Goal Position": Register(30, 2), "Moving Speed": Register(32, 2),
-    "Torque Limit": Register(34, 2, 1023), "Present Position": Register(36, 2), "Present Voltage": Register(42, 1, 120),
-    "Present Temperature": Register(43, 1, 30), "Moving": Register(46, 1),
+    "Torque Limit": Register(34, 2, 1023), "Present Position": Register(36, 2), "Present Load": Register(40, 2, 0),
+    "Present Voltage": Register(42, 1, 120), "Present Temperature": Register(43, 1, 30), "Moving": Register(46, 1),
 }
 CONTROL_TABLES = {"XL430-W250": XL430_W250, "XM430-W350": XM430_W350, "XL-320": XL_320, "AX-12A": AX_12A}
+#: First RAM address: registers below it are EEPROM (kept over power-off; with torque on a Protocol 2.0 servo
+#: answers a write there with Access Error, e-Manual "Control Table": "Data in the EEPROM Area can only be
+#: modified when the value of Torque Enable(64) is set to 0").
+EEPROM_END = {"XL430-W250": 64, "XM430-W350": 64, "XL-320": 24, "AX-12A": 24}
+
+_X_BAUD_RATES = {0: 9_600, 1: 57_600, 2: 115_200, 3: 1_000_000, 4: 2_000_000, 5: 3_000_000, 6: 4_000_000,
+                 7: 4_500_000}
+#: Baud Rate register value -> bits per second, per model. X series: e-Manual "Baud Rate(8)" table (factory 1
+#: = 57,600). XL-320: "Baud Rate(4)" 0..3 (factory 3 = 1 Mbps). AX: "Baud Rate(4)": rate = 2,000,000 /
+#: (value + 1), the values the e-Manual lists (16 is 117,647 bps for 115,200, -2.1 %; 34 is 57,143 bps for
+#: 57,600, +0.8 %: within a UART's tolerance, so the nominal rate is given); factory 1 = 1 Mbps.
+BAUD_RATES = {"XL430-W250": _X_BAUD_RATES, "XM430-W350": _X_BAUD_RATES,
+              "XL-320": {0: 9_600, 1: 57_600, 2: 115_200, 3: 1_000_000},
+              "AX-12A": {1: 1_000_000, 3: 500_000, 4: 400_000, 7: 250_000, 9: 200_000, 16: 115_200, 34: 57_600,
+                         103: 19_200, 207: 9_600}}
 
 # Status packets. Protocol 1.0: the ERROR byte is a bit field. Protocol 2.0: bit 7 is the Alert flag (a
 # hardware error; details in the model's Hardware Error Status register), bits 0..6 an error number.
