@@ -8,6 +8,7 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Mapping
 
+from gaitbot.servos.health import HealthReading
 from gaitbot.servos.registers import RegisterWrite
 
 
@@ -92,6 +93,11 @@ class Bus(ABC):
     def read_present_ticks(self, ids: Iterable[int]) -> dict[int, int]:
         """Present positions (sync read where the protocol has it); reads retry a bounded number of times."""
 
+    def read_health(self, servo_id: int) -> HealthReading:
+        """One servo's health block in one READ: present position, temperature, input voltage and (where the
+        model has it) present load (gaitbot.servos.health). Retried like a present-position read."""
+        raise NotImplementedError(f"{type(self).__name__} cannot read servo health")
+
     def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
         """Write a setting (a gain, a lock flag) to each servo, waiting for each one's status packet.
 
@@ -107,5 +113,5 @@ class Bus(ABC):
         self.close()
 
 
-__all__ = ["Bus", "BusError", "PortError", "ServoTimeout", "ServoLate", "CorruptReplies", "ServoStatusError",
+__all__ = ["Bus", "HealthReading", "BusError", "PortError", "ServoTimeout", "ServoLate", "CorruptReplies", "ServoStatusError",
            "RegisterWrite"]

@@ -28,7 +28,8 @@ def make_bus(backend: str, protocol: float, port: str, baudrate: int, models: Ma
     SDK's reply timeout (2 x 16 ms USB latency + 2 ms + the packet's bytes) when set.
     """
     cls = bus_class(backend)
-    handler = MockPort(backend, protocol, models, port_name=port) if dry_run else cls.sdk.PortHandler(port)
+    handler = MockPort(backend, protocol, models, port_name=port, baudrate=baudrate) if dry_run \
+        else cls.sdk.PortHandler(port)
     if reply_timeout_ms is not None and not dry_run:
         _set_reply_timeout(handler, reply_timeout_ms)
     if recorder is not None:

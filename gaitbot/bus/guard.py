@@ -51,6 +51,9 @@ class LimitGuard(Bus):
     def read_present_ticks(self, ids: Iterable[int]) -> dict[int, int]:
         return self.inner.read_present_ticks(ids)
 
+    def read_health(self, servo_id: int):
+        return self.inner.read_health(servo_id)
+
     def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
         """Settings are not goals: passed on (the backend refuses a write to the goal or torque register)."""
         self.inner.write_register(ids, address, length, value)

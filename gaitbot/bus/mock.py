@@ -7,10 +7,14 @@ byte for byte what a real run would send. It parses each instruction packet with
 
 * ping: status packet (Dynamixel 2.0 adds model number and firmware version);
 * write: stored in the servo's control table, status packet unless broadcast (the table starts with
-  the model number, the centre tick as goal and present position, and the factory gain register);
+  the vendor table's factory values, the servo's id, the Baud Rate register of the bus's rate, the
+  model number and the centre tick as goal and present position);
 * sync write: stored, no status packet;
 * read / sync read: status packets with the control-table bytes; present position mirrors the last
   goal position written (initially the model's centre tick).
+
+Servos made for a bus rate (``baudrate``) answer only while the port is set to that rate, as real
+servos do (a scan at other rates finds nothing); without it they answer at any rate.
 
 Time is virtual: when no reply bytes are pending, ``isPacketTimeout`` is True at once, so a
 missing servo costs no wall-clock time.
@@ -20,8 +24,11 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from gaitbot.servos import dynamixel, vendor, wire
+from gaitbot.servos import baud_rates, baud_register_value, vendor, wire
 from gaitbot.servos.models import ServoModel
+
+#: A UART reads bytes sent at a rate within about 3 % of its own (a 10-bit frame drifts half a bit by then).
+BAUD_TOLERANCE = 0.03
 
 _TABLE_SIZE_BYTES = 1024
 
@@ -33,7 +40,7 @@ class MockPort:
     """
 
     def __init__(self, backend: str, protocol: float, models: Mapping[int, ServoModel],
-                 port_name: str = "mock") -> None:
+                 port_name: str = "mock", baudrate: int | None = None) -> None:
         self.vendor = vendor(backend)  # ValueError for an unknown backend
         self.backend = backend
         self.protocol = float(protocol)
@@ -49,7 +56,11 @@ class MockPort:
         self._tx_buffer = bytearray()
         self._rx_buffer = bytearray()
         self._drop_replies = 0
-        self.tables = {servo_id: self._initial_table(model) for servo_id, model in self.models.items()}
+        if baudrate is not None and any(baud_register_value(m.name, baudrate) is None for m in self.models.values()):
+            baudrate = None  # a rate some servo's register cannot hold: a rate-blind chain, as before
+        self.servo_baudrate = baudrate  # the rate the servos were set to (None: they answer at any rate)
+        self.tables = {servo_id: self.initial_table(model, servo_id, baudrate)
+                       for servo_id, model in self.models.items()}
 
     # --- PortHandler interface -------------------------------------------------------------
     def openPort(self) -> bool:  # noqa: N802 (SDK names)
@@ -125,10 +136,22 @@ class MockPort:
         return int.from_bytes(self.tables[servo_id][start:start + model.len_present_position], model.byte_order)
 
     # --- the emulated chain ----------------------------------------------------------------
-    def _initial_table(self, model: ServoModel) -> bytearray:
+    @staticmethod
+    def initial_table(model: ServoModel, servo_id: int, baudrate: int | None = None) -> bytearray:
+        """A servo's control table after power-on: the vendor table's factory values, ``servo_id`` in its
+        ID register, the Baud Rate register of ``baudrate`` (when the model can run at it; else the
+        factory rate), the model number and the centre tick as goal and present position."""
         table = bytearray(_TABLE_SIZE_BYTES)
+        for register in model.control_table.values():
+            if register.factory is not None:
+                table[register.address:register.address + register.size] = \
+                    register.factory.to_bytes(register.size, model.byte_order)
         number = model.control_table["Model Number"]
         table[number.address:number.address + number.size] = model.model_number.to_bytes(number.size, model.byte_order)
+        table[model.control_table["ID"].address] = servo_id
+        value = baud_register_value(model.name, baudrate) if baudrate is not None else None
+        if value is not None:
+            table[model.control_table["Baud Rate"].address] = value
         centre = model.centre_tick.to_bytes(model.len_goal_position, model.byte_order)
         table[model.addr_goal_position:model.addr_goal_position + model.len_goal_position] = centre
         table[model.addr_present_position:model.addr_present_position + model.len_present_position] = \
@@ -138,6 +161,17 @@ class MockPort:
             for address in model.gain.addresses:
                 table[address:address + model.gain.length] = factory
         return table
+
+    @staticmethod
+    def servo_rate(model: ServoModel, table: bytearray) -> int | None:
+        """The rate a servo listens at, from its Baud Rate register (None: a value gaitbot does not know)."""
+        return baud_rates(model.name).get(table[model.control_table["Baud Rate"].address])
+
+    def hears(self, servo_id: int) -> bool:
+        """Whether the servo reads what the host sends: set to the port's rate (or made rate-blind)."""
+        if self.servo_baudrate is None:
+            return True
+        return rates_match(self.servo_rate(self.models[servo_id], self.tables[servo_id]), self.baudrate)
 
     def _answer(self, raw: bytes) -> None:
         frame = wire.parse(raw, self.framing, status=False)
@@ -153,8 +187,8 @@ class MockPort:
 
     def _targets(self, packet_id: int) -> list[int]:
         if packet_id == wire.BROADCAST_ID:
-            return list(self.tables)
-        return [packet_id] if packet_id in self.tables else []
+            return [i for i in self.tables if self.hears(i)]
+        return [packet_id] if packet_id in self.tables and self.hears(packet_id) else []
 
     def _address_and_rest(self, params: bytes) -> tuple[int, bytes]:
         return wire.address_and_rest(params, self.framing)
@@ -162,34 +196,36 @@ class MockPort:
     def _ping(self, frame: wire.Frame) -> None:
         for servo_id in self._targets(frame.packet_id):
             extra = b""
-            if self.framing == "v2":
-                number = self.models[servo_id].model_number
-                extra = bytes([number & 0xFF, number >> 8, dynamixel.PING_FIRMWARE_VERSION])
+            if self.framing == "v2":  # Protocol 2.0 ping: model number (2 bytes) and firmware version
+                model = self.models[servo_id]
+                firmware = self.tables[servo_id][model.control_table["Firmware Version"].address]
+                extra = bytes([model.model_number & 0xFF, model.model_number >> 8, firmware])
             self._reply(servo_id, extra)
 
     def _read(self, frame: wire.Frame) -> None:
         address, length, _ = wire.address_length_and_rest(frame.params, self.framing)
-        if frame.packet_id in self.tables:
+        if self._targets(frame.packet_id) == [frame.packet_id]:
             self._reply(frame.packet_id, bytes(self.tables[frame.packet_id][address:address + length]))
 
     def _write(self, frame: wire.Frame) -> None:
         address, data = self._address_and_rest(frame.params)
-        for servo_id in self._targets(frame.packet_id):
+        targets = self._targets(frame.packet_id)
+        for servo_id in targets:
             self._store(servo_id, address, data)
-        if frame.packet_id in self.tables:
+        if frame.packet_id in targets:  # a broadcast write gets no status packet
             self._reply(frame.packet_id, b"")
 
     def _sync_write(self, frame: wire.Frame) -> None:
         address, length, body = wire.address_length_and_rest(frame.params, self.framing)
         for offset in range(0, len(body) - length, length + 1):
             servo_id = body[offset]
-            if servo_id in self.tables:
+            if servo_id in self.tables and self.hears(servo_id):
                 self._store(servo_id, address, body[offset + 1:offset + 1 + length])
 
     def _sync_read(self, frame: wire.Frame) -> None:
         address, length, ids = wire.address_length_and_rest(frame.params, self.framing)
         for servo_id in ids:
-            if servo_id in self.tables:
+            if servo_id in self.tables and self.hears(servo_id):
                 self._reply(servo_id, bytes(self.tables[servo_id][address:address + length]))
 
     def _store(self, servo_id: int, address: int, data: bytes) -> None:
@@ -211,3 +247,10 @@ class MockPort:
             return
         self.rx_packets.append(packet)
         self._rx_buffer += packet
+
+
+def rates_match(servo_rate: int | None, line_rate: int | None) -> bool:
+    """A servo at ``servo_rate`` reads bytes sent at ``line_rate`` (within BAUD_TOLERANCE); None line: any."""
+    if line_rate is None:
+        return True
+    return servo_rate is not None and abs(servo_rate - line_rate) <= BAUD_TOLERANCE * servo_rate

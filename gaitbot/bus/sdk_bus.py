@@ -15,6 +15,7 @@ from typing import Any
 
 from gaitbot.bus.base import Bus, BusError, CorruptReplies, PortError, ServoLate, ServoStatusError, ServoTimeout
 from gaitbot.servos import dynamixel, has_sync_read, max_servo_id, wire
+from gaitbot.servos.health import HealthReading, decode_health, health_block
 from gaitbot.servos.models import ServoModel
 from gaitbot.servos.status import describe_status_error, hardware_error_address
 
@@ -290,6 +291,13 @@ class SdkBus(Bus):
             ticks = {servo_id: self._read_one(servo_id) for servo_id in wanted}
         return {servo_id: ticks[servo_id] for servo_id in wanted}
 
+    def read_health(self, servo_id: int) -> HealthReading:
+        """The servo's health block (gaitbot.servos.health: position, voltage, temperature, load) in one READ,
+        retried like a present-position read; error bits in its status raise ServoStatusError."""
+        self._require_open()
+        block = health_block(self._model(servo_id))
+        return decode_health(block, servo_id, self._read_block(servo_id, block.address, block.length))
+
     # --- internals ------------------------------------------------------------------------
     def _sync_read(self, wanted: list[int]) -> dict[int, int]:
         """GroupSyncRead's exchange, but keeping each status packet's error byte (GroupSyncRead drops it)."""
@@ -327,7 +335,10 @@ class SdkBus(Bus):
         raise self._no_answer(failed_id, outcomes[failed_id], "sync reads")
 
     def _read_one(self, servo_id: int) -> int:
-        address, length = self._present
+        return self._decode(self._read_block(servo_id, *self._present), self._model(servo_id))
+
+    def _read_block(self, servo_id: int, address: int, length: int) -> bytes:
+        """One READ of ``length`` bytes at ``address``, retried (the fault policy of every read)."""
         outcomes: dict[int, list[int]] = {}
         for _ in range(1 + self.retries):
             self._before_transaction()
@@ -337,7 +348,7 @@ class SdkBus(Bus):
             self._raise_on_port_failure(result, servo_id)
             if result == self.sdk.COMM_SUCCESS and len(data) >= length:
                 self._answered(servo_id, error)
-                return self._decode(bytes(data[:length]), self._model(servo_id))
+                return bytes(data[:length])
             self._failed_attempt(servo_id, result, outcomes)
         raise self._no_answer(servo_id, outcomes[servo_id], "reads")
 

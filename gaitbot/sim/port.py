@@ -39,7 +39,8 @@ class SimPort(MockPort):
     """A MockPort whose walking servos are ``robot``'s joints, on the time ``now()`` tells (seconds)."""
 
     def __init__(self, config: RobotConfig, robot: SimRobot, now: Callable[[], float], port_name: str = "sim") -> None:
-        super().__init__(config.bus.backend, config.bus.protocol, config.models_by_id, port_name=port_name)
+        super().__init__(config.bus.backend, config.bus.protocol, config.models_by_id, port_name=port_name,
+                         baudrate=config.bus.baudrate)
         self.robot = robot
         self.now = now
         walking = config.walking_joints
