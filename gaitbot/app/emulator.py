@@ -6,9 +6,13 @@ and answers on it like a chain of servos until Ctrl-C:
     python tools/servo_emulator.py --robot config/xl430-biped.toml --log goals.jsonl
     python tools/servo_emulator.py --protocol dxl2 --ids 1-6 --late 3:60
     gaitbot walk --robot config/xl430-biped.toml --distance 0.3 --port /dev/pts/N
+    python tools/servo_emulator.py --robot xl430-biped --factory-fresh --one-at-a-time   # for gaitbot setup
+    python tools/servo_emulator.py --robot xl430-biped --load 3:60 --temperature 3:60 --heat-rate 2
 
-Faults start after ``--fault-after-frames`` goal frames and ``--fault-after-s`` seconds from the first
-packet received (default: at once). docs/emulator.md lists every option.
+Faults (and the supply's sag) start after ``--fault-after-frames`` goal frames and ``--fault-after-s``
+seconds from the first packet received (default: at once). With ``--one-at-a-time``, each line read on
+standard input (Enter) unplugs the servo connected now and plugs in the next. docs/emulator.md lists
+every option.
 """
 
 from __future__ import annotations
@@ -16,8 +20,10 @@ from __future__ import annotations
 import argparse
 import sys
 
-from gaitbot.bus.emulator import FAULT_KINDS, EmulatorConfig, Faults, ServoEmulator, hand_from_trajectory
-from gaitbot.robot.config import load_robot_config, resolve_config
+from gaitbot.bus.emulator import (FAULT_KINDS, EmulatorConfig, Faults, Heat, ServoEmulator, hand_from_ticks,
+                                  hand_from_trajectory)
+from gaitbot.robot.calibration_file import load_robot_with_calibration
+from gaitbot.servos import baud_rates, baud_register_value
 from gaitbot.servos.models import servo_model
 
 #: --protocol name -> (backend, protocol, default model)
@@ -47,7 +53,43 @@ def _id_value(text: str, what: str) -> tuple[int, str]:
     return int(servo_id), value
 
 
+def _id_numbers(items, flag: str, low: float, high: float, unit: str) -> dict[int, float]:
+    out = {}
+    for item in items or []:
+        servo_id, value = _id_value(item, flag)
+        number = float(value)
+        if not low <= number <= high:
+            raise ValueError(f"{flag} {item!r}: the value must be within {low:g}..{high:g} {unit}")
+        out[servo_id] = number
+    return out
+
+
 def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
+    config = _chain_from_args(args)
+    config.heat = Heat(args.ambient, args.heat_rate, args.cool_time)
+    if not (args.heat_rate >= 0 and args.cool_time > 0):
+        raise ValueError("--heat-rate must be >= 0 C/s and --cool-time a positive number of seconds")
+    config.loads_pct = _id_numbers(args.load, "--load", 0.0, 100.0, "%")
+    config.temperatures_c = _id_numbers(args.temperature, "--temperature", -20.0, 150.0, "C")
+    if args.supply_v is not None and not args.supply_v >= 0:
+        raise ValueError(f"--supply-v must be 0 or more volts, got {args.supply_v}")
+    if not args.voltage_sag >= 0:
+        raise ValueError(f"--voltage-sag must be 0 or more volts per second, got {args.voltage_sag}")
+    config.supply_v, config.voltage_sag_v_per_s = args.supply_v, args.voltage_sag
+    if args.one_at_a_time and not config.fresh:
+        raise ValueError("--one-at-a-time needs --factory-fresh (a chain of new servos, connected one by one)")
+    config.one_at_a_time = args.one_at_a_time
+    models = list(config.fresh) or list(config.models.values())
+    if not config.fresh:
+        for model in models:
+            if baud_register_value(model.name, config.baudrate) is None:
+                rates = ", ".join(f"{r:,}" for r in baud_rates(model.name).values())
+                raise ValueError(f"--baudrate {config.baudrate}: a {model.name} cannot run at it (its Baud Rate "
+                                 f"register holds {rates})")
+    return config
+
+
+def _chain_from_args(args: argparse.Namespace) -> EmulatorConfig:
     faults = Faults(after_frames=args.fault_after_frames, after_s=args.fault_after_s,
                     close_after_frames=args.close_after_frames, close_after_s=args.close_after_s)
     faults.silent = set(args.silent or [])
@@ -66,23 +108,37 @@ def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
         if not kinds <= set(FAULT_KINDS):
             raise ValueError(f"--error {item!r}: kinds are {', '.join(FAULT_KINDS)} (join with +)")
         faults.errors[servo_id] = kinds
+    if args.hand and args.hand_ticks:
+        raise ValueError("give --hand or --hand-ticks, not both")
+    hand = hand_from_ticks(args.hand_ticks, args.hand_rate) if args.hand_ticks else None
     if args.robot:
-        robot = load_robot_config(resolve_config(args.robot))
-        hand = hand_from_trajectory(robot, args.hand, args.hand_rate) if args.hand else None
-        return EmulatorConfig(robot.bus.backend, robot.bus.protocol, robot.models_by_id,
+        robot = load_robot_with_calibration(args.robot, args.calibration)
+        if args.hand:
+            hand = hand_from_trajectory(robot, args.hand, args.hand_rate)
+        fresh = tuple(j.model for j in robot.joints)[:args.factory_fresh or None] \
+            if args.factory_fresh is not None else ()
+        return EmulatorConfig(robot.bus.backend, robot.bus.protocol, {} if fresh else robot.models_by_id,
                               args.baudrate or robot.bus.baudrate, faults, args.log, robot.name,
-                              {j.name: j.id for j in robot.joints}, args.seed, args.return_delay_us, hand)
+                              None if fresh else {j.name: j.id for j in robot.joints}, args.seed,
+                              args.return_delay_us, hand, fresh=fresh)
     if args.hand:
         raise ValueError("--hand needs --robot (its calibration turns the trajectory's angles into ticks)")
+    if args.calibration:
+        raise ValueError("--calibration needs --robot (it applies to a robot config)")
     if not args.protocol:
         raise ValueError("give --robot CONFIG or --protocol dxl1|dxl2|feetech-sts|feetech-scs with --ids")
     backend, protocol, default_model = PROTOCOLS[args.protocol]
     model = servo_model(args.model or default_model)
     if model.family != backend or protocol not in model.protocols:
         raise ValueError(f"--model {model.name} does not speak {args.protocol}")
+    if args.factory_fresh is not None:
+        if args.factory_fresh < 1:
+            raise ValueError("--factory-fresh N: without --robot, give how many servos (1 or more)")
+        return EmulatorConfig(backend, protocol, {}, args.baudrate or 1_000_000, faults, args.log, seed=args.seed,
+                              return_delay_us=args.return_delay_us, hand=hand, fresh=(model,) * args.factory_fresh)
     models = {i: model for i in parse_ids(args.ids)}
     return EmulatorConfig(backend, protocol, models, args.baudrate or 1_000_000, faults, args.log,
-                          seed=args.seed, return_delay_us=args.return_delay_us)
+                          seed=args.seed, return_delay_us=args.return_delay_us, hand=hand)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -107,7 +163,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--close-after-s", type=float, help="the port disappears this long after the first packet")
     p.add_argument("--hand", metavar="FILE", help="with --robot: a trajectory (.csv/.npz) a hand plays on the servos "
                    "while their torque is off, one sample per read cycle")
+    p.add_argument("--hand-ticks", metavar="FILE", help="a hand script in raw ticks: a CSV whose header holds servo "
+                   "ids and each row one sample (no calibration involved), e.g. a scripted hand for gaitbot calibrate")
     p.add_argument("--hand-rate", type=float, metavar="HZ", help="advance the --hand script with time at HZ instead")
+    p.add_argument("--calibration", metavar="FILE", help="with --robot: a calibration file applied to the config "
+                   "(for --hand), as gaitbot's commands apply it")
+    p.add_argument("--factory-fresh", type=int, nargs="?", const=0, metavar="N",
+                   help="new servos as shipped: every one at id 1 and its factory baud rate (X series 57,600; AX, "
+                        "XL-320, Feetech 1,000,000); with --robot one per joint (or the first N), else N of --model")
+    p.add_argument("--one-at-a-time", action="store_true", help="with --factory-fresh: only one servo is connected; "
+                   "Enter on standard input unplugs it and plugs in the next (as for gaitbot setup)")
+    p.add_argument("--load", action="append", metavar="ID:PCT", help="the load (%% of its maximum torque) this "
+                   "servo holds while its torque is on; it warms with it (default 0)")
+    p.add_argument("--temperature", action="append", metavar="ID:C", help="this servo's temperature at the start "
+                   "(default: --ambient)")
+    p.add_argument("--ambient", type=float, default=25.0, metavar="C", help="ambient temperature (default 25 C)")
+    p.add_argument("--heat-rate", type=float, default=0.5, metavar="C_PER_S",
+                   help="warming at full load, C per second (default 0.5; it scales with the load squared)")
+    p.add_argument("--cool-time", type=float, default=300.0, metavar="S",
+                   help="time constant of cooling towards ambient, seconds (default 300)")
+    p.add_argument("--supply-v", type=float, metavar="V", help="supply voltage (default: the servos' usual, "
+                   "e.g. 12.0 V for X and AX, 7.4 V for STS3215)")
+    p.add_argument("--voltage-sag", type=float, default=0.0, metavar="V_PER_S",
+                   help="the supply falls this many volts per second once faults start (--fault-after-*)")
     return p
 
 
@@ -121,11 +199,22 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     emulator = ServoEmulator(config)
     print(emulator.path, flush=True)
-    names = sorted({m.name for m in config.models.values()})
-    print(f"emulating {len(config.models)} {'/'.join(names)} servos (ids {sorted(config.models)}) on "
-          f"{config.backend} protocol {config.protocol}; Ctrl-C to stop", file=sys.stderr, flush=True)
+    if config.fresh:
+        names = sorted({m.name for m in config.fresh})
+        how = "one at a time (Enter plugs in the next)" if config.one_at_a_time else "all connected"
+        print(f"emulating {len(config.fresh)} factory-fresh {'/'.join(names)} servos (all id 1, factory baud rate), "
+              f"{how}, on {config.backend} protocol {config.protocol}; Ctrl-C to stop", file=sys.stderr, flush=True)
+    else:
+        names = sorted({m.name for m in config.models.values()})
+        print(f"emulating {len(config.models)} {'/'.join(names)} servos (ids {sorted(config.models)}) on "
+              f"{config.backend} protocol {config.protocol}; Ctrl-C to stop", file=sys.stderr, flush=True)
     try:
-        emulator.serve()
+        if config.one_at_a_time:
+            emulator.start()
+            _plug_on_enter(emulator)
+            emulator.wait_closed()
+        else:
+            emulator.serve()
     except KeyboardInterrupt:
         pass
     finally:
@@ -136,6 +225,19 @@ def main(argv: list[str] | None = None) -> int:
         print(f"servo_emulator: {emulator.chain.goal_frames} goal frames logged to {config.log_path}",
               file=sys.stderr)
     return 0
+
+
+def _plug_on_enter(emulator: ServoEmulator) -> None:
+    """Each line on standard input: unplug the servo connected now and plug in the next."""
+    total = len(emulator.chain.units)
+    print(f"servo 1 of {total} connected", file=sys.stderr, flush=True)
+    for _line in sys.stdin:
+        unit = emulator.plug_next()
+        if unit is None:
+            print(f"no servo left to plug in (all {total} done)", file=sys.stderr, flush=True)
+            continue
+        print(f"servo {unit.index + 1} of {total} connected ({unit.model.name}, id {unit.servo_id})",
+              file=sys.stderr, flush=True)
 
 
 if __name__ == "__main__":
