@@ -1,0 +1,371 @@
+"""A port of servos nobody has introduced yet: find them at any id and baud rate, read any register, and
+write the few registers bring-up needs (gaitbot setup, gaitbot scan).
+
+:class:`SdkBus` drives a known chain (ids and models from a config); a probe knows only the backend and
+the protocol. It uses the vendor SDK's PortHandler and packet handler (ping, read, write) like the walk
+does; two exchanges are its own, because the SDKs offer none that fits:
+
+* **broadcast ping** (Dynamixel 2.0 and Feetech): one PING to id 254 and every status packet that comes
+  back, read with gaitbot.servos.wire. Dynamixel 2.0 servos answer one after another in id order
+  (e-Manual Protocol 2.0, "Ping"); the probe waits the SDK's own window for that (253 status packets'
+  bytes + 3 ms a servo + 16 ms, ``broadcastPing`` in dynamixel_sdk), or, given ``reply_timeout_ms``,
+  until the line has been quiet that long. Feetech servos all answer a broadcast ping at once
+  (Feetech's protocol manual: "cannot be used when multiple servos are connected"), so one clean status
+  packet means one servo and a damaged one means several.
+* **one id at a time** (Dynamixel 1.0, which has no broadcast ping, and Feetech when its broadcast ping
+  came back damaged): a PING per id, each waiting the reply timeout. A status packet that arrives after
+  its timeout is not lost: it is found among the stale bytes dropped before the next ping, and its id
+  is pinged again with a long timeout.
+
+Two servos at one id and baud rate answer at once and garble each other (e-Manual: "If DYNAMIXELs with
+the same ID are connected, packet collision and network problems will occur"): every damaged status
+packet is counted in :attr:`ProbeResult.damaged`, so bring-up can refuse a bus with more than one servo.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+from gaitbot.bus.base import PortError, ServoTimeout
+from gaitbot.bus.sdk_bus import PORT_EXCEPTIONS, is_pseudo_terminal
+from gaitbot.servos import control_table, max_servo_id, vendor, wire
+from gaitbot.servos.models import SERVO_MODELS, ServoModel
+
+#: dynamixel_sdk's broadcastPing window: status packets of 14 bytes from every id, 3 ms a servo, 16 ms latency.
+_BROADCAST_STATUS_BYTES = 14
+_BROADCAST_MS_PER_SERVO = 3.0
+_USB_LATENCY_MS = 16.0
+#: A second look at a servo that answered late, or whose answer must be sure: this long per reply.
+CONFIRM_TIMEOUT_MS = 100.0
+
+
+@dataclass(frozen=True)
+class ServoFound:
+    """A servo that answered: its id, the baud rate it answered at, its model number (None: not read) and
+    model name (None: a number gaitbot does not know)."""
+
+    servo_id: int
+    baudrate: int
+    model_number: int | None
+    model_name: str | None
+
+    @property
+    def model(self) -> ServoModel | None:
+        return SERVO_MODELS.get(self.model_name) if self.model_name else None
+
+
+@dataclass
+class ProbeResult:
+    """What a search at one baud rate saw: the servos that answered and the damaged status packets."""
+
+    baudrate: int
+    found: list[ServoFound] = field(default_factory=list)
+    damaged: int = 0
+
+
+def model_name_of(backend: str, number: int) -> str | None:
+    """The model with this model number on a ``backend`` bus (None: gaitbot does not know it)."""
+    for name, known in vendor(backend).MODEL_NUMBERS.items():
+        if known == number:
+            return name
+    return None
+
+
+class ProbeBus:
+    """A ``backend`` bus speaking ``protocol`` on ``port_handler`` (the SDK's PortHandler, a MockPort or a
+    recorder around either), its servos unknown. Open it, set a baud rate, then ``search`` / ``read`` /
+    ``write``. ``reply_timeout_ms`` replaces the SDK's reply timeout (about 34 ms) for every exchange."""
+
+    def __init__(self, backend: str, protocol: float, port_name: str, port_handler: Any,
+                 reply_timeout_ms: float | None = None, retries: int = 3) -> None:
+        self.backend = backend
+        self.protocol = float(protocol)
+        self.port_name = port_name
+        self.port = port_handler
+        self.reply_timeout_ms = reply_timeout_ms
+        self.retries = retries
+        self.framing = wire.framing_for(backend, protocol)
+        self.sdk = _sdk(backend)
+        self._ph: Any = None
+        self.baudrate: int | None = None
+        self.open_notes: list[str] = []
+
+    # --- the port ---------------------------------------------------------------------------
+    def open(self) -> None:
+        self._ph = _packet_handler(self.backend, self.protocol)
+        try:
+            opened = self.port.openPort()
+        except PORT_EXCEPTIONS as exc:
+            raise PortError(f"cannot open serial port {self.port_name}: {exc}") from exc
+        if not opened:
+            raise PortError(f"cannot open serial port {self.port_name}")
+
+    def close(self) -> None:
+        try:
+            self.port.closePort()
+        except PORT_EXCEPTIONS:
+            pass
+
+    def __enter__(self) -> "ProbeBus":
+        self.open()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def set_baudrate(self, baudrate: int) -> None:
+        """Switch the host to ``baudrate``; PortError when the SDK or the adapter refuses it."""
+        try:
+            ok = self.port.setBaudRate(int(baudrate))
+        except PORT_EXCEPTIONS as exc:
+            raise PortError(f"serial port {self.port_name} refused {baudrate} baud: {exc}") from exc
+        if not ok:
+            raise PortError(f"serial port {self.port_name} refused {baudrate} baud (the SDK does not offer it)")
+        self.baudrate = int(baudrate)
+
+    # --- finding servos ---------------------------------------------------------------------
+    def search(self, ids: range | None = None) -> ProbeResult:
+        """Every servo answering at the current baud rate (ids: every usable id)."""
+        if self.baudrate is None:
+            raise RuntimeError("set a baud rate first")
+        ids = ids if ids is not None else range(0, max_servo_id(self.backend, self.protocol) + 1)
+        result = ProbeResult(self.baudrate)
+        if self.backend == "dynamixel" and self.protocol == 2.0:
+            answered, result.damaged = self._broadcast_ping(all_at_once=False)
+            numbers = answered
+        elif self.backend == "feetech":
+            answered, result.damaged = self._broadcast_ping(all_at_once=True)
+            if result.damaged or not answered:
+                numbers = {}
+                if result.damaged:  # several servos: ask them one by one
+                    numbers, result.damaged = self._ping_each(ids)
+            else:
+                numbers = answered
+        else:
+            numbers, result.damaged = self._ping_each(ids)
+        for servo_id in sorted(i for i in numbers if i in ids):
+            number = numbers[servo_id]
+            if number is None:
+                number = self.model_number(servo_id)
+            result.found.append(ServoFound(servo_id, self.baudrate, number,
+                                           model_name_of(self.backend, number) if number is not None else None))
+        return result
+
+    def _broadcast_ping(self, all_at_once: bool) -> tuple[dict[int, int | None], int]:
+        """{id: model number (2.0) or None} of every clean status packet, and the count of damaged ones."""
+        packet = (wire.build_v2 if self.framing == "v2" else wire.build_v1)(wire.BROADCAST_ID, wire.INST_PING)
+        self._drop_stale()
+        self._write(packet)
+        byte_ms = 10_000.0 / self.baudrate
+        if all_at_once:  # one status packet's time, as for a ping of one servo
+            window_ms = 6 * byte_ms + self._reply_ms()
+        else:
+            window_ms = (_BROADCAST_STATUS_BYTES * (max_servo_id(self.backend, self.protocol) + 1) * byte_ms
+                         + _BROADCAST_MS_PER_SERVO * (max_servo_id(self.backend, self.protocol) + 1)
+                         + _USB_LATENCY_MS)
+        data = self._listen(window_ms, quiet_ms=self.reply_timeout_ms)
+        answered: dict[int, int | None] = {}
+        damaged = 0
+        for raw, is_packet in wire.split_complete(bytearray(data), self.framing):
+            frame = wire.parse(raw, self.framing, status=True) if is_packet else None
+            if frame is None or not frame.checksum_ok:
+                damaged += 1
+                continue
+            number = None
+            if self.framing == "v2" and len(frame.params) >= 2:
+                number = frame.params[0] | frame.params[1] << 8
+            if frame.packet_id in answered:
+                damaged += 1  # one id twice: two servos there
+            answered[frame.packet_id] = number
+        return answered, damaged
+
+    def _ping_each(self, ids) -> tuple[dict[int, int | None], int]:
+        answered: dict[int, int | None] = {}
+        late: set[int] = set()
+        damaged = 0
+        for servo_id in ids:
+            late |= self._drop_stale()
+            outcome, number = self._ping_once(servo_id)
+            if outcome == "ok":
+                answered[servo_id] = number
+            elif outcome == "damaged":
+                damaged += 1
+        late |= self._drop_stale()
+        for servo_id in sorted(late - set(answered)):
+            outcome, number = self._ping_once(servo_id, CONFIRM_TIMEOUT_MS)
+            if outcome == "ok":
+                answered[servo_id] = number
+        return answered, damaged
+
+    def _ping_once(self, servo_id: int, timeout_ms: float | None = None) -> tuple[str, int | None]:
+        """("ok" | "silent" | "damaged", the model number the SDK's ping read) of one PING, no retry.
+        Dynamixel's ping returns the model number (2.0: in the status; 1.0: read at address 0); the Feetech
+        SDK's assumes one byte order for every servo, so it is left to :meth:`model_number`."""
+        with self._timeout(timeout_ms):
+            number, result, _error = self._guard(lambda: self._ph.ping(self.port, servo_id))
+        if result == self.sdk.COMM_SUCCESS:
+            return "ok", (number if self.backend == "dynamixel" else None)
+        return ("damaged" if result == self.sdk.COMM_RX_CORRUPT else "silent"), None
+
+    def ping(self, servo_id: int, timeout_ms: float | None = None) -> bool:
+        """Whether ``servo_id`` answers a PING (with the retries of every read)."""
+        for _ in range(1 + self.retries):
+            self._drop_stale()
+            if self._ping_once(servo_id, timeout_ms)[0] == "ok":
+                return True
+        return False
+
+    # --- registers --------------------------------------------------------------------------
+    def read(self, servo_id: int, address: int, length: int) -> tuple[bytes, int]:
+        """(``length`` bytes at ``address``, the status error byte); ServoTimeout after the retries."""
+        result = self.sdk.COMM_SUCCESS
+        for _ in range(1 + self.retries):
+            self._drop_stale()
+            data, result, error = self._guard(lambda: self._ph.readTxRx(self.port, servo_id, address, length))
+            if result == self.sdk.COMM_SUCCESS and len(data) >= length:
+                return bytes(data[:length]), error
+        raise ServoTimeout(f"servo {servo_id} on {self.port_name} at {self.baudrate} baud did not answer a read of "
+                           f"address {address} ({self._ph.getTxRxResult(result)})", servo_id=servo_id,
+                           result_code=result)
+
+    def write(self, servo_id: int, address: int, data: bytes, *, confirm: bool = True) -> int:
+        """One WRITE of ``data`` at ``address``: with ``confirm``, retried until the status packet comes and
+        its error byte returned; without, sent once and not waited for (an id or baud-rate write, which
+        the servo may answer as its new self). Bring-up reads every write back anyway."""
+        data = bytes(data)
+        if not confirm:
+            self._drop_stale()
+            self._guard(lambda: self._ph.writeTxOnly(self.port, servo_id, address, len(data), list(data)))
+            return 0
+        result = self.sdk.COMM_SUCCESS
+        for _ in range(1 + self.retries):
+            self._drop_stale()
+            result, error = self._guard(lambda: self._ph.writeTxRx(self.port, servo_id, address, len(data),
+                                                                    list(data)))
+            if result == self.sdk.COMM_SUCCESS:
+                return error
+        raise ServoTimeout(f"servo {servo_id} on {self.port_name} did not confirm writing to address {address} "
+                           f"({self._ph.getTxRxResult(result)})", servo_id=servo_id, result_code=result)
+
+    def model_number(self, servo_id: int) -> int | None:
+        """The servo's model number from its Model Number register (Dynamixel address 0, Feetech 3, the
+        word in the servo's own byte order: Feetech's END register at 2 says which)."""
+        table = control_table(next(iter(vendor(self.backend).CONTROL_TABLES)))
+        register = table["Model Number"]
+        try:
+            if self.backend == "feetech":
+                end = table["Byte Order"].address
+                data, _ = self.read(servo_id, end, register.address + register.size - end)
+                order = "big" if data[0] else "little"
+                return int.from_bytes(data[register.address - end:], order)
+            data, _ = self.read(servo_id, register.address, register.size)
+        except ServoTimeout:
+            return None
+        return int.from_bytes(data, "little")
+
+    # --- internals --------------------------------------------------------------------------
+    def _reply_ms(self) -> float:
+        return self.reply_timeout_ms if self.reply_timeout_ms is not None else 2 * _USB_LATENCY_MS + 2.0
+
+    def _timeout(self, timeout_ms: float | None):
+        return _ReplyTimeout(self.port, timeout_ms if timeout_ms is not None else self.reply_timeout_ms)
+
+    def _guard(self, call):
+        try:
+            return call()
+        except PORT_EXCEPTIONS as exc:
+            self.port.is_using = False
+            raise PortError(f"serial port {self.port_name} failed: {exc}") from exc
+
+    def _write(self, packet: bytes) -> None:
+        try:
+            self.port.writePort(list(packet))
+        except PORT_EXCEPTIONS as exc:
+            raise PortError(f"serial port {self.port_name} failed: {exc}") from exc
+
+    def _listen(self, window_ms: float, quiet_ms: float | None) -> bytes:
+        """Every byte within ``window_ms``; with ``quiet_ms``, stop once the line has been quiet that long."""
+        data = bytearray()
+        self.port.setPacketTimeoutMillis(window_ms)
+        last_s = time.monotonic()
+        while True:
+            available = self._guard(self.port.getBytesAvailable)
+            if available:
+                data += bytes(self._guard(lambda: self.port.readPort(available)))
+                last_s = time.monotonic()
+            elif self.port.isPacketTimeout():
+                return bytes(data)
+            elif quiet_ms is not None and (time.monotonic() - last_s) * 1000.0 > quiet_ms:
+                return bytes(data)
+            else:
+                time.sleep(0.0002)
+
+    def _drop_stale(self) -> set[int]:
+        """Read and drop bytes left over from an earlier exchange; the ids of clean status packets among them."""
+        available = getattr(self.port, "getBytesAvailable", None)
+        ids: set[int] = set()
+        if callable(available):
+            pending = self._guard(available)
+            if pending:
+                stale = bytes(self._guard(lambda: self.port.readPort(pending)))
+                for raw, is_packet in wire.split_complete(bytearray(stale), self.framing):
+                    if is_packet:
+                        frame = wire.parse(raw, self.framing, status=True)
+                        if frame.checksum_ok:
+                            ids.add(frame.packet_id)
+        reset = getattr(self.port, "reset_input_buffer", None)
+        if callable(reset):
+            reset()
+        elif getattr(self.port, "ser", None) is not None:
+            self.port.ser.reset_input_buffer()
+        return ids
+
+
+class _ReplyTimeout:
+    """Within the block, the port's reply timeout is ``timeout_ms`` beyond the packet's bytes (None: the SDK's)."""
+
+    def __init__(self, port: Any, timeout_ms: float | None) -> None:
+        self.port, self.timeout_ms = port, timeout_ms
+        self._saved: Any = None
+
+    def __enter__(self) -> None:
+        if self.timeout_ms is None or not hasattr(self.port, "tx_time_per_byte"):
+            return
+        self._saved = self.port.__dict__.get("setPacketTimeout")
+        port, timeout_ms = self.port, self.timeout_ms
+
+        def set_packet_timeout(packet_length):
+            port.packet_start_time = port.getCurrentTime()
+            port.packet_timeout = port.tx_time_per_byte * packet_length + timeout_ms
+
+        port.setPacketTimeout = set_packet_timeout
+
+    def __exit__(self, *exc) -> None:
+        if self.timeout_ms is None or not hasattr(self.port, "tx_time_per_byte"):
+            return
+        if self._saved is None:
+            del self.port.setPacketTimeout
+        else:
+            self.port.setPacketTimeout = self._saved
+
+
+def _sdk(backend: str):
+    if backend == "dynamixel":
+        import dynamixel_sdk
+        return dynamixel_sdk
+    import scservo_sdk
+    return scservo_sdk
+
+
+def _packet_handler(backend: str, protocol: float):
+    if backend == "dynamixel":
+        from gaitbot.bus.dynamixel import StuffingProtocol2PacketHandler
+        import dynamixel_sdk
+        return StuffingProtocol2PacketHandler() if float(protocol) == 2.0 else dynamixel_sdk.PacketHandler(1.0)
+    import scservo_sdk
+    return scservo_sdk.PacketHandler(0)  # words are decoded here, in each servo's own byte order
+
+
+__all__ = ["ProbeBus", "ProbeResult", "ServoFound", "model_name_of", "is_pseudo_terminal"]
