@@ -32,7 +32,7 @@ def run(args) -> int:
 
 
 def _check_trajectory_file(args, path: Path, margin: float) -> int:
-    config = load_robot(args.robot)
+    config = load_robot(args.robot, getattr(args, "calibration", None))
     if path.suffix == ".csv" and path.is_file():
         refuse_truncated_csv(path)
     report = preflight(config, load_fast(path), margin)
@@ -45,7 +45,7 @@ def _check_trajectory_file(args, path: Path, margin: float) -> int:
 
 
 def _check_recording(args, path: Path, margin: float) -> int:
-    config = robot_for_recording(path, args.robot, load_robot)
+    config = robot_for_recording(path, args.robot, lambda robot: load_robot(robot, getattr(args, "calibration", None)))
     report = check_recording(config, path, margin, allow_partial_last_line=bool(getattr(args, "allow_partial", False)))
     if args.json:
         print(json.dumps({**report.to_dict(), "config": str(config.path)}, indent=2))

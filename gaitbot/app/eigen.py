@@ -68,7 +68,7 @@ def run_fit(args) -> int:
     out = Path(args.output)
     if out.suffix != ".npz":
         raise UsageError(f"-o {out}: the model file must end in .npz")
-    config = load_robot(args.robot)
+    config = load_robot(args.robot, getattr(args, "calibration", None))
     geometry = leg_geometry(config)
     options = FitOptions(samples=args.samples, basis=args.basis, n_basis=args.n_basis, roughness=args.roughness,
                          pose_variance=args.pose_variance, pose_tolerance_deg=args.pose_tolerance_deg,
@@ -137,7 +137,7 @@ def run_synth(args) -> int:
     if out.suffix not in (".csv", ".npz"):
         raise UsageError(f"-o {out}: the output must end in .csv or .npz")
     model = EigenGaitModel.load(args.model)
-    config = load_robot(args.robot)
+    config = load_robot(args.robot, getattr(args, "calibration", None))
     if leg_geometry(config) != model.geometry:
         raise UsageError(f"--robot {config.name}: its leg differs from the leg the model {args.model} was fitted with")
     settings = walk_settings(config)

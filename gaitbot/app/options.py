@@ -14,7 +14,8 @@ from gaitbot.errors import UserError
 from gaitbot.gait.geometry import LegGeometry
 from gaitbot.gait.planning import perturb_steps, steps_for_distance
 from gaitbot.gait.walker import WalkSettings, make_context
-from gaitbot.robot.config import ConfigError, RobotConfig, default_config_path, load_robot_config, resolve_config
+from gaitbot.robot.calibration_file import load_robot_with_calibration
+from gaitbot.robot.config import ConfigError, RobotConfig
 from gaitbot.robot.walk_settings import GaitSource, leg_geometry, walk_settings
 
 
@@ -22,13 +23,14 @@ class UsageError(UserError, ValueError):
     """Bad input from the user: printed as one line, exit status 2, nothing sent to a servo."""
 
 
-def load_robot(robot: str | None) -> RobotConfig:
-    """The robot config named by ``--robot`` (a path or a shipped name), or the built-in default; a
-    ``gait.rate_hz`` the bus cannot carry is refused at load (gaitbot.bus.budget)."""
+def load_robot(robot: str | None, calibration: str | None = None) -> RobotConfig:
+    """The robot config named by ``--robot`` (a path or a shipped name), or the built-in default, with its
+    calibration applied (``--calibration FILE``, else ``<config>.calibration.toml`` beside it if there is
+    one: gaitbot.robot.calibration_file); a ``gait.rate_hz`` the bus cannot carry is refused at load
+    (gaitbot.bus.budget)."""
     try:
-        path = resolve_config(robot) if robot else default_config_path()
-        return load_robot_config(path, extra_checks=[bus_budget_check])
-    except ConfigError:
+        return load_robot_with_calibration(robot, calibration, extra_checks=[bus_budget_check])
+    except (ConfigError, UserError):
         raise
     except (OSError, ValueError, KeyError) as exc:
         raise UsageError(f"--robot {robot}: {exc}") from None
@@ -59,7 +61,7 @@ def check_rate_option(config: RobotConfig, rate_hz: float | None, label: str | N
 
 def gait_source(args) -> GaitSource:
     """Geometry and settings from ``--robot`` (or the default robot), with ``--thigh/--shank/--foot`` overrides."""
-    robot = load_robot(getattr(args, "robot", None))
+    robot = load_robot(getattr(args, "robot", None), getattr(args, "calibration", None))
     geometry = leg_geometry(robot)
     overrides = {k: getattr(args, k, None) for k in ("thigh", "shank", "foot")}
     if any(v is not None for v in overrides.values()):

@@ -8,7 +8,7 @@ from gaitbot.bus.factory import make_robot_bus
 
 
 def run(args) -> int:
-    config = load_robot(args.robot)
+    config = load_robot(args.robot, getattr(args, "calibration", None))
     port = serial_port(config, args.port, args.dry_run)
     ids = range(0, 253) if args.all else config.ids
     names = {j.id: j.name for j in config.joints}

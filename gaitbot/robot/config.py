@@ -29,6 +29,7 @@ from gaitbot.fields import FieldError, Fields, kind, read_toml
 from gaitbot.gait.trajectory import WALKING_JOINTS
 from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
 from gaitbot.robot.gains import GainError, gain_for_error
+from gaitbot.robot.health import HealthSettings, read_health
 from gaitbot.servos import BACKENDS, dynamixel, feetech, max_servo_id
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
 
@@ -158,6 +159,8 @@ class RobotConfig:
     mass: MassSettings = MassSettings()
     servo: ServoSettings = ServoSettings()
     terrain: TerrainReach | None = None
+    calibration_file: Path | None = None  # the calibration file applied on top (gaitbot.robot.calibration_file)
+    health: HealthSettings = HealthSettings()  # [health] overrides (gaitbot.robot.health)
 
     @property
     def walking_joints(self) -> tuple[JointConfig, ...]:
@@ -268,7 +271,7 @@ def load_robot_config(path: str | Path, *, extra_checks: Iterable[ConfigCheck] =
     return config
 
 
-_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain")
+_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain", "health")
 _MASS_KEYS = ("torso_kg", "thigh_kg", "shank_kg", "foot_kg")
 _SERVO_KEYS = ("stall_torque_nm", "no_load_speed_rpm", "full_torque_error_deg")
 _TERRAIN_KEYS = ("max_rise_m", "max_drop_m", "max_gap_m")
@@ -303,8 +306,9 @@ class _Reader(Fields):
         if "terrain" in data:
             t = self.table(data, "terrain", "terrain", _TERRAIN_KEYS)
             terrain = TerrainReach(*(self.number(t, key, "terrain", non_negative=True) for key in _TERRAIN_KEYS))
+        health = read_health(self, data, joints)
         return RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
-                           mass=mass, servo=servo, terrain=terrain)
+                           mass=mass, servo=servo, terrain=terrain, health=health)
 
     def mass(self, t: dict) -> MassSettings:
         defaults = MassSettings()
@@ -426,13 +430,9 @@ class _Reader(Fields):
         if min_deg > max_deg:
             raise self.fail(f"{f}.min_deg", f"{min_deg} is above max_deg {max_deg}")
         for key, angle_deg in (("min_deg", min_deg), ("max_deg", max_deg)):
-            tick = int(angle_rad_to_ticks(math.radians(angle_deg), zero_tick, direction, model.ticks_per_rad))
-            if not model.min_tick <= tick <= model.max_tick:
-                lo, hi = sorted(_tick_range_deg(model, zero_tick, direction))
-                raise self.fail(f"{f}.{key}", f"{angle_deg} deg maps to tick {tick}, outside the {model_name}'s "
-                                              f"range {model.min_tick}..{model.max_tick} (with zero_tick {zero_tick} "
-                                              f"and direction {direction} the allowed angles are "
-                                              f"{lo:.1f}..{hi:.1f} deg)")
+            problem = angle_outside_servo(model, zero_tick, direction, angle_deg)
+            if problem:
+                raise self.fail(f"{f}.{key}", problem)
 
         max_velocity_dps = self.number(t, "max_velocity_dps", f, positive=True)
         max_acceleration_dps2 = self.number(t, "max_acceleration_dps2", f, positive=True)
@@ -465,6 +465,17 @@ class _Reader(Fields):
                                 f"{j.model.name} sends {j.model.byte_order}-endian positions but "
                                 f"joints.{first.name} ({first.model.name}) is {first.model.byte_order}-endian; "
                                 f"one bus needs one byte order (e.g. Feetech STS or SCS, not both)")
+
+
+def angle_outside_servo(model: ServoModel, zero_tick: int, direction: int, angle_deg: float) -> str | None:
+    """Why ``angle_deg`` cannot be reached with this zero tick and direction (its tick lies outside the
+    servo's range, and the allowed angles are given), or None when it can."""
+    tick = int(angle_rad_to_ticks(math.radians(angle_deg), zero_tick, direction, model.ticks_per_rad))
+    if model.min_tick <= tick <= model.max_tick:
+        return None
+    lo, hi = sorted(_tick_range_deg(model, zero_tick, direction))
+    return (f"{angle_deg} deg maps to tick {tick}, outside the {model.name}'s range {model.min_tick}..{model.max_tick} "
+            f"(with zero_tick {zero_tick} and direction {direction} the allowed angles are {lo:.1f}..{hi:.1f} deg)")
 
 
 def _tick_range_deg(model: ServoModel, zero_tick: int, direction: int) -> tuple[float, float]:
