@@ -32,6 +32,7 @@ from gaitbot.robot.config import RobotConfig
 from gaitbot.robot.gains import gain_notes, gain_writes
 from gaitbot.robot.walk_settings import leg_geometry
 from gaitbot.stream.clock import MonotonicClock, VirtualClock
+from gaitbot.stream.health import HealthMonitor
 from gaitbot.stream.record import record_session
 
 QUESTION = "Turn torque off on {n} servos? The legs will go limp. [y/N] "
@@ -145,7 +146,7 @@ def _status_line(rate_hz: float):
 
 
 def run(args) -> int:
-    config = load_robot(args.robot)
+    config = load_robot(args.robot, getattr(args, "calibration", None))
     out = Path(args.output)
     _check_output(out)
     rate_hz = config.gait.rate_hz
@@ -167,8 +168,9 @@ def run(args) -> int:
     if args.hold:
         for note in gain_notes(config):
             print(f"note: {note}", file=sys.stderr)
+    health = HealthMonitor.for_robot(config, warn, clock.now)
     result = record_session(bus, config.ids, 1.0 / rate_hz, sink, confirm=confirm, n_samples=n_samples, clock=clock,
-                            hold_at_end=args.hold, setup_writes=gain_writes(config))
+                            hold_at_end=args.hold, setup_writes=gain_writes(config), health=health)
     if sink.status is not None and sink.writer is not None:
         sys.stderr.write("\n")
     for note in getattr(bus, "open_notes", []):
@@ -181,6 +183,8 @@ def run(args) -> int:
         print(f"wrote {out}: {rows} samples{usable}, {rows / rate_hz:.2f} s at {rate_hz:g} Hz; root from foot "
               f"contact, {sink.last_root_m[0]:.4f} m travelled")
         print(result.timing.summary())
+    if health.summary():
+        print(health.summary())
     mode = "dry run (mock bus, simulated clock)" if args.dry_run else f"{config.bus.backend} on {port}"
     print(f"{config.name}: {mode}. {result.message()}")
     return result.exit_code

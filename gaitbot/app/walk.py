@@ -20,11 +20,13 @@ from gaitbot.robot.walk_settings import joint_limits_ticks
 from gaitbot.sim import import_mujoco
 from gaitbot.sim.video import check_video_path
 from gaitbot.stream.clock import MonotonicClock, VirtualClock
+from gaitbot.stream.health import HealthMonitor
 from gaitbot.stream.session import walk_session
 
 
-def _status_line(total: int, strikes, rate_hz: float):
-    """A cheap live status line: frame, step and late frames, rewritten in place on a terminal."""
+def _status_line(total: int, strikes, rate_hz: float, health: HealthMonitor):
+    """A cheap live status line: frame, step, late frames and the latest servo health warning, rewritten in
+    place on a terminal."""
     out = sys.stderr
     if not out.isatty():
         return None
@@ -34,16 +36,23 @@ def _status_line(total: int, strikes, rate_hz: float):
         if k % 6:
             return
         step = sum(1 for t in times if t <= k / rate_hz)
-        out.write(f"\rframe {k + 1}/{total}  step {step}/{len(times)}  late {stats.late_frames}   ")
+        warning = f"  warning: {health.status}" if health.status else ""
+        out.write(f"\rframe {k + 1}/{total}  step {step}/{len(times)}  late {stats.late_frames}{warning}   ")
         out.flush()
 
     return on_frame
 
 
+def _warn_line(text: str) -> None:
+    """A health warning the first time it happens: on its own line (a terminal's status line keeps the latest)."""
+    prefix = "\n" if sys.stderr.isatty() else ""
+    print(f"{prefix}warning: {text}", file=sys.stderr, flush=True)
+
+
 def run(args) -> int:
     check_sim_arguments(args)
     check_reply_timeout(args.reply_timeout_ms)
-    config = load_robot(args.robot)
+    config = load_robot(args.robot, getattr(args, "calibration", None))
     check_rate_option(config, args.rate)
     args.robot = str(config.path)
     source, walker, trajectory = trajectory_for_robot(args)
@@ -74,12 +83,13 @@ def run(args) -> int:
     velocity, acceleration = joint_limits_ticks(config)
     for note in gain_notes(config):
         print(f"note: {note}", file=sys.stderr)
+    health = HealthMonitor.for_robot(config, _warn_line, clock.now)
     try:
         result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
                               max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
                               torque_off_on_exit=config.bus.torque_off_on_exit,
-                              on_frame=_status_line(len(frames), walker.heel_strikes, source.settings.rate_hz),
-                              setup_writes=gain_writes(config))
+                              on_frame=_status_line(len(frames), walker.heel_strikes, source.settings.rate_hz, health),
+                              setup_writes=gain_writes(config), health=health)
     finally:
         if recorder is not None:
             recorder.close()
@@ -99,10 +109,14 @@ def run(args) -> int:
         mode = "dry run (mock bus, paced in real time)"
     else:
         mode = "dry run (mock bus, simulated clock: timing figures are exact by construction; --realtime paces it)"
+    if config.calibration_file is not None:
+        print(f"note: calibration {config.calibration_file} applied", file=sys.stderr)
     print(f"{config.name}: {mode}: {len(walker.planned_steps)} heel strikes, "
           f"{trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.3f} m planned. {result.message()}")
     if result.walk_stats is not None:
         print(result.walk_stats.summary())
+    if health.summary():
+        print(health.summary())
     if args.record:
         print(f"recording: {args.record}")
     if sim is not None:

@@ -25,13 +25,14 @@ import numpy as np
 
 from gaitbot.bus.base import Bus, BusError, RegisterWrite
 from gaitbot.stream.clock import Clock, MonotonicClock
+from gaitbot.stream.health import HealthMonitor, ServoHealthStop
 from gaitbot.stream.pacing import LATE_THRESHOLD_S, paced_deadlines
 from gaitbot.stream.session import EXIT_CODES, prepare, write_settings
 from gaitbot.stream.signals import Terminated, sigterm_raises_terminated
 
 #: Exit status of each outcome: a stopped recording (Ctrl-C) is a normal end.
 RECORD_EXIT_CODES = {"declined": 0, "completed": 0, "stopped": 0, "terminated": EXIT_CODES["terminated"],
-                     "bus_error": EXIT_CODES["bus_error"], "file_error": 1}
+                     "bus_error": EXIT_CODES["bus_error"], "health_stop": EXIT_CODES["health_stop"], "file_error": 1}
 #: fsync the sink about once a second (every row is flushed to the OS as it is written anyway).
 SYNC_EVERY_S = 1.0
 
@@ -89,6 +90,7 @@ class RecordResult:
         head = {"declined": "Recording cancelled: nothing was sent, torque left as it was",
                 "completed": "Recording completed", "stopped": "Recording stopped (Ctrl-C)",
                 "terminated": "Recording terminated (SIGTERM)", "bus_error": "Recording stopped by a bus error",
+                "health_stop": "Recording stopped to protect a servo",
                 "file_error": "Recording stopped: the file could not be written"}
         parts = [head[self.outcome]]
         if self.error is not None:
@@ -100,8 +102,11 @@ class RecordResult:
 def record_session(bus: Bus, ids: Sequence[int], period_s: float, sink: SampleSink, *,
                    confirm: Callable[[int], bool], n_samples: int | None = None, clock: Clock | None = None,
                    hold_at_end: bool = False, handle_sigterm: bool = True,
-                   setup_writes: Sequence[RegisterWrite] = ()) -> RecordResult:
+                   setup_writes: Sequence[RegisterWrite] = (), health: HealthMonitor | None = None) -> RecordResult:
     """Record until ``n_samples`` are read, Ctrl-C, SIGTERM or a bus error (see the module docstring).
+
+    ``health``: after each sample one servo's health block is read, in turn, and handed to the monitor
+    (warnings; a stop threshold ends the recording as "health_stop", exit 1, torque left off).
 
     ``confirm(n)`` asks the person whether ``n`` servos may go limp. ``bus`` should be wrapped in a
     LimitGuard when ``hold_at_end`` is set, so a pose outside the limits is never sent as a goal.
@@ -126,11 +131,13 @@ def record_session(bus: Bus, ids: Sequence[int], period_s: float, sink: SampleSi
                 state["sink_open"] = True
                 state["torque"] = "off"  # before the call: a torque-off that fails halfway is still off where it took
                 bus.set_torque(ids, False)
-                _read_loop(bus, ids, period_s, sink, clock, timing, n_samples)
+                _read_loop(bus, ids, period_s, sink, clock, timing, n_samples, health)
             except KeyboardInterrupt:  # before torque off (at the question) it is a refusal
                 outcome = "stopped" if state["torque"] == "off" else "declined"
             except Terminated:
                 outcome = "terminated"
+            except ServoHealthStop as exc:
+                outcome, error = "health_stop", exc
             except BusError as exc:
                 outcome, error = "bus_error", exc
             except OSError as exc:  # the sink's file; the bus's own OS errors arrive as PortError
@@ -155,7 +162,7 @@ def record_session(bus: Bus, ids: Sequence[int], period_s: float, sink: SampleSi
 
 
 def _read_loop(bus: Bus, ids: list[int], period_s: float, sink: SampleSink, clock: Clock, timing: ReadTiming,
-               n_samples: int | None) -> None:
+               n_samples: int | None, health: HealthMonitor | None = None) -> None:
     start_s = clock.now()
     sync_every = max(1, int(round(SYNC_EVERY_S / period_s)))
     for k, deadline_s, read_start_s in paced_deadlines(clock, period_s, start_s, 0.9 * period_s):
@@ -166,6 +173,8 @@ def _read_loop(bus: Bus, ids: list[int], period_s: float, sink: SampleSink, cloc
         timing.lateness_s.append(read_start_s - deadline_s)
         timing.read_s.append(done_s - read_start_s)
         sink.add(k * period_s, np.array([int(present[i]) for i in ids], dtype=np.int64))
+        if health is not None:
+            health.observe(bus.read_health(ids[k % len(ids)]))
         if (k + 1) % sync_every == 0:
             sink.sync()
 

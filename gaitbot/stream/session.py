@@ -16,12 +16,13 @@ from numpy.typing import ArrayLike
 
 from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite, ServoTimeout
 from gaitbot.stream.clock import Clock, MonotonicClock
+from gaitbot.stream.health import HealthMonitor, ServoHealthStop
 from gaitbot.stream.pacing import StreamStats, Streamer, as_tick_frames
 from gaitbot.stream.ramps import ramp_ticks, stop_ticks
 from gaitbot.stream.signals import Terminated, install_sigterm_handler, restore_sigterm_handler
 
 #: Exit codes by outcome, the shell's conventions (128 + SIGINT, 128 + SIGTERM).
-EXIT_CODES = {"completed": 0, "interrupted": 130, "terminated": 143, "bus_error": 1}
+EXIT_CODES = {"completed": 0, "interrupted": 130, "terminated": 143, "bus_error": 1, "health_stop": 1}
 
 
 # --------------------------------------------------------------------------- before walking
@@ -64,14 +65,23 @@ def write_settings(bus: Bus, writes: Iterable[RegisterWrite]) -> None:
         bus.write_register(write.ids, write.address, write.length, write.value)
 
 
+def check_health(bus: Bus, ids: Sequence[int], health: HealthMonitor | None) -> None:
+    """Read every servo's health once before anything moves (ServoHealthStop refuses the start)."""
+    if health is None:
+        return
+    for servo_id in ids:
+        health.observe(bus.read_health(int(servo_id)))
+
+
 # --------------------------------------------------------------------------- the session
 
 @dataclass(frozen=True)
 class SessionResult:
     """How a walk session ended.
 
-    outcome: "completed" | "interrupted" | "terminated" | "bus_error".
-    exit_code: 0 | 130 | 143 | 1 respectively.
+    outcome: "completed" | "interrupted" | "terminated" | "bus_error" | "health_stop" (a servo's temperature
+    or voltage reached its stop threshold: gaitbot.stream.health).
+    exit_code: 0 | 130 | 143 | 1 | 1 respectively.
     error: the bus error that ended the walk (or stopped preparation), for the caller's message.
     walk_stats: timing of the walk itself (None if it never started).
     reached_stand: the last frame sent is within 1 tick of ``stand_ticks`` (the ramp's own tolerance).
@@ -89,7 +99,8 @@ class SessionResult:
 
     def message(self) -> str:
         head = {"completed": "Walk completed", "interrupted": "Walk interrupted (Ctrl-C)",
-                "terminated": "Walk terminated (SIGTERM)", "bus_error": "Walk stopped by a bus error"}
+                "terminated": "Walk terminated (SIGTERM)", "bus_error": "Walk stopped by a bus error",
+                "health_stop": "Walk stopped to protect a servo"}
         parts = [head.get(self.outcome, self.outcome)]
         if self.error is not None:
             parts.append(f"error: {self.error}")
@@ -103,7 +114,7 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
                  torque_off_on_exit: bool = False,
                  on_frame: Callable[[int, StreamStats], None] | None = None,
                  handle_sigterm: bool = True, monitor_servos: bool = True,
-                 setup_writes: Sequence[RegisterWrite] = ()) -> SessionResult:
+                 setup_writes: Sequence[RegisterWrite] = (), health: HealthMonitor | None = None) -> SessionResult:
     """Open, check, ramp to the first pose, walk, and leave the robot in a known pose.
 
     Sequence: ``bus.open()`` -> :func:`prepare` (ping all, read present) -> ``setup_writes`` (the
@@ -120,6 +131,11 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
     ``len(ids)`` frames plus the bus's bounded retries; the safe stop ramp is not read back (it must
     reach the healthy servos whatever the faulty one does). ``handle_sigterm``: SIGTERM raises
     :class:`~gaitbot.stream.signals.Terminated` (main thread only; the old handler is restored).
+
+    ``health``: that read-back reads the servo's whole health block instead (position, temperature,
+    voltage, load: one READ, ``Bus.read_health``) and hands it to the monitor, which warns or stops the
+    walk (outcome "health_stop", the safe stop of a bus fault, exit 1); every servo is also read once
+    before torque goes on, so a robot already too hot or on a flat battery does not start.
     """
     ids = [int(i) for i in ids]
     walk = as_tick_frames(frames, len(ids))
@@ -143,7 +159,9 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
         sync read would otherwise ask every servo on its own every frame)."""
         servo_id = ids[next_checked[0] % len(ids)]
         next_checked[0] += 1
-        if servo_id not in bus.read_present_ticks([servo_id]):
+        if health is not None:
+            health.observe(bus.read_health(servo_id))
+        elif servo_id not in bus.read_present_ticks([servo_id]):
             raise ServoTimeout(f"servo {servo_id} stopped answering reads during the walk", servo_id=servo_id)
 
     def streamer(callback=None, monitored: bool = False) -> Streamer:
@@ -157,6 +175,7 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             state.opened = True  # close even if open fails halfway: a recording may already be started
             bus.open()
             present = prepare(bus, ids)
+            check_health(bus, ids, health)
             write_settings(bus, setup_writes)
             # Already at the first pose (within a tick): that pose is the goal written before torque on,
             # and it counts as the walk's first frame, so a recording holds exactly the trajectory.
@@ -175,6 +194,9 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             outcome, error = "completed", None
         except (KeyboardInterrupt, Terminated) as exc:
             outcome, error = ("terminated" if isinstance(exc, Terminated) else "interrupted"), None
+            state.safe_stop(streamer, stop)
+        except ServoHealthStop as exc:  # a servo too hot or under-powered: the safe stop of a bus fault
+            outcome, error = "health_stop", exc
             state.safe_stop(streamer, stop)
         except BusError as exc:
             outcome, error = "bus_error", exc
