@@ -17,7 +17,21 @@ from gaitbot.errors import UserError
 #: Subcommand -> the module of gaitbot.app whose ``run(args)`` does it (imported when used: ``plot``
 #: needs matplotlib, ``walk --sim`` MuJoCo, and the rest should not wait for them).
 COMMANDS = {name: f"gaitbot.app.{name}" for name in ("plan", "generate", "plot", "walk", "check", "eigen", "record",
-                                                     "scan")}
+                                                     "scan", "setup", "calibrate")}
+
+CALIBRATION_HELP = ("calibration file (gaitbot calibrate) applied on top of the robot config (default: "
+                    "<config stem>.calibration.toml beside the config, if there is one)")
+REPLY_TIMEOUT_HELP = "how long to wait for each status packet (default: the SDK's, about 34 ms at 1 Mbaud)"
+
+
+def _calibration(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--calibration", metavar="FILE", help=CALIBRATION_HELP)
+
+
+def _described(sub, name: str, help: str, description: str, examples: str) -> argparse.ArgumentParser:
+    """A subcommand with a description and examples in its --help."""
+    return sub.add_parser(name, help=help, description=description, epilog="examples:\n" + examples,
+                          formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
 def _walk_inputs(p: argparse.ArgumentParser) -> None:
@@ -29,6 +43,7 @@ def _walk_inputs(p: argparse.ArgumentParser) -> None:
                    help="add zero-mean random noise of this standard deviation (metres) to step lengths")
     p.add_argument("--seed", type=int, help="random seed for --perturb")
     p.add_argument("--robot", help="robot config (a .toml path or a shipped name; default xl430-biped)")
+    _calibration(p)
     p.add_argument("--thigh", type=float, help="thigh length in metres (overrides the robot's leg)")
     p.add_argument("--shank", type=float, help="shank length in metres")
     p.add_argument("--foot", type=float, help="foot length in metres")
@@ -56,6 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help="trajectory (.csv or .npz)")
     p.add_argument("-o", "--output", required=True, help="picture file, e.g. walk.png")
     p.add_argument("--robot", help="robot config whose leg drew the trajectory (default xl430-biped)")
+    _calibration(p)
     p.add_argument("--thigh", type=float)
     p.add_argument("--shank", type=float)
     p.add_argument("--foot", type=float)
@@ -81,6 +97,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("check", help="check a trajectory or a recorded run against the robot's limits")
     p.add_argument("file", help="trajectory (.csv, .npz) or bus recording (.jsonl)")
     p.add_argument("--robot", help="robot config (default: a recording's own robot, else xl430-biped)")
+    _calibration(p)
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.add_argument("--margin-deg", type=float, default=0.0, help="warn within this many degrees of a limit")
     p.add_argument("--allow-partial", action="store_true",
@@ -92,6 +109,7 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("examples", nargs="+", help="trajectory files (.npz or .csv), one walk each")
     q.add_argument("-o", "--output", required=True, help="model file, e.g. model.npz")
     q.add_argument("--robot", help="robot config whose leg walked the examples (default xl430-biped)")
+    _calibration(q)
     q.add_argument("--samples", type=int, default=100, help="samples per resampled cycle (default 100)")
     q.add_argument("--basis", choices=("fourier", "bspline"), default="fourier")
     q.add_argument("--n-basis", type=int, default=31, help="basis functions per channel (odd for fourier)")
@@ -113,10 +131,12 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--pose-deg", help="six joint angles in degrees the motion must pass through")
     q.add_argument("--pose-time", type=float, help="seconds into each synthesised cycle for --pose-deg")
     q.add_argument("--robot", help="robot config (default xl430-biped)")
+    _calibration(q)
     q.add_argument("-o", "--output", required=True, help="walk.csv or walk.npz")
 
     p = sub.add_parser("record", help="record a motion made by hand: torque off, positions read to a trajectory CSV")
     p.add_argument("--robot", help="robot config (a .toml path or a shipped name; default xl430-biped)")
+    _calibration(p)
     p.add_argument("-o", "--output", required=True, help="trajectory CSV, written as it is read, e.g. demo.csv")
     p.add_argument("--duration", type=float, help="seconds to record (default: until Ctrl-C)")
     p.add_argument("--yes", action="store_true", help="turn torque off without asking")
@@ -127,11 +147,57 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--reply-timeout-ms", type=float,
                    help="how long to wait for each status packet (default: the SDK's, about 34 ms at 1 Mbaud)")
 
-    p = sub.add_parser("scan", help="list the servos that answer")
-    p.add_argument("--robot", help="robot config (default xl430-biped)")
+    p = _described(
+        sub, "scan", "list every servo that answers, at every baud rate",
+        "Ping every id at every baud rate of the configured protocol (or --baud) and list each servo that answers: "
+        "id, baud rate, model, firmware, present position (ticks and as its joint's angle), input voltage, "
+        "temperature, load, torque and hardware errors in words; then the configured joints that did not answer. "
+        "Reads only. Exit 0 when every configured joint answered as configured, else 1.",
+        "  gaitbot scan --robot config/xl430-biped.toml --port /dev/ttyUSB0\n"
+        "  gaitbot scan --robot ax12a-biped --baud 1000000 --json\n"
+        "  gaitbot scan --dry-run")
+    p.add_argument("--robot", help="robot config: its protocol, and the joints to match (default xl430-biped)")
+    _calibration(p)
     p.add_argument("--port", help="serial port (default: the robot config's)")
-    p.add_argument("--all", action="store_true", help="ping every id, not only the configured ones")
-    p.add_argument("--dry-run", action="store_true", help="scan the mock bus")
+    p.add_argument("--baud", type=int, help="scan this baud rate only (default: every rate a servo of the "
+                   "configured protocol can run at)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.add_argument("--reply-timeout-ms", type=float, help=REPLY_TIMEOUT_HELP + "; a short one (5) speeds up "
+                   "Protocol 1.0, which pings 254 ids one by one at each rate")
+    p.add_argument("--dry-run", action="store_true", help="scan the mock bus (the config's servos at its baud rate)")
+
+    p = _described(
+        sub, "setup", "give new servos, one at a time, the config's ids and baud rate",
+        "For each joint (or each --joint), asks you to connect only that joint's servo, finds it at any id and any "
+        "baud rate its model can run at, and writes the joint's id and the config's baud rate (torque off, the "
+        "Feetech EEPROM lock, ID, Baud Rate: nothing else), then reads them back. Refuses (exit 2, nothing "
+        "written) when more than one servo answers or the servo is not the config's model.",
+        "  gaitbot setup --robot config/xl430-biped.toml --port /dev/ttyUSB0\n"
+        "  gaitbot setup --robot ax12a-biped --joint knee_pitch_left --yes --reply-timeout-ms 5")
+    p.add_argument("--robot", help="robot config: the ids, models and baud rate to give (default xl430-biped)")
+    _calibration(p)
+    p.add_argument("--joint", action="append", metavar="NAME", help="set up this joint only (repeat for several; "
+                   "default: every joint, in the config's order)")
+    p.add_argument("--port", help="serial port (default: the robot config's)")
+    p.add_argument("--yes", action="store_true", help="do not wait for Enter: the servo is already connected")
+    p.add_argument("--reply-timeout-ms", type=float, help=REPLY_TIMEOUT_HELP + "; a short one (5) speeds up the "
+                   "search, which tries every id at every baud rate")
+
+    p = _described(
+        sub, "calibrate", "measure each joint's zero tick and direction into a calibration file",
+        "Torque off; you hold the robot in its zero pose (legs straight, feet flat) and press Enter: the present "
+        "positions become the zero ticks. Then, joint by joint, you bend the joint in its positive direction "
+        "(told in words) and press Enter: the sign of the change is its direction, the size is checked against "
+        "the configured limits. Writes the calibration file, which every command applies on top of the config "
+        "(--calibration FILE, or <config stem>.calibration.toml beside the config). Writes only Torque Enable = 0 "
+        "to the servos.",
+        "  gaitbot calibrate --robot robots/mybot.toml -o robots/mybot.calibration.toml\n"
+        "  gaitbot walk --robot robots/mybot.toml --calibration mybot.calibration.toml --distance 0.5")
+    p.add_argument("--robot", help="robot config (default xl430-biped)")
+    p.add_argument("-o", "--output", required=True, help="calibration file to write (.toml)")
+    p.add_argument("--port", help="serial port (default: the robot config's)")
+    p.add_argument("--yes", action="store_true", help="turn torque off without asking")
+    p.add_argument("--reply-timeout-ms", type=float, help=REPLY_TIMEOUT_HELP)
     return parser
 
 

@@ -10,6 +10,7 @@ from gaitbot.bus.feetech import FeetechBus
 from gaitbot.bus.guard import LimitGuard
 from gaitbot.bus.log import BusRecorder
 from gaitbot.bus.mock import MockPort
+from gaitbot.bus.probe import ProbeBus
 from gaitbot.robot.calibration import tick_limits
 from gaitbot.robot.config import RobotConfig
 from gaitbot.servos.models import ServoModel
@@ -77,3 +78,13 @@ def make_mock_bus(backend: str, protocol: float, models: Mapping[int, ServoModel
                   recorder: BusRecorder | None = None) -> Bus:
     """A dry-run bus (the real backend class on a MockPort); its port is ``bus.port``."""
     return make_bus(backend, protocol, "mock", baudrate, models, dry_run=True, recorder=recorder)
+
+
+def make_probe_bus(backend: str, protocol: float, port: str, *, dry_run: bool = False,
+                   models: Mapping[int, ServoModel] | None = None, baudrate: int | None = None,
+                   reply_timeout_ms: float | None = None) -> ProbeBus:
+    """A bus of servos not known yet (gaitbot setup, scan) on ``port``; with ``dry_run`` a MockPort holding
+    ``models`` set to ``baudrate``. Not opened here."""
+    handler = MockPort(backend, protocol, models or {}, port_name=port, baudrate=baudrate) if dry_run \
+        else bus_class(backend).sdk.PortHandler(port)
+    return ProbeBus(backend, protocol, port, handler, reply_timeout_ms=reply_timeout_ms)

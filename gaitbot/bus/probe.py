@@ -14,8 +14,9 @@ does; two exchanges are its own, because the SDKs offer none that fits:
   packet means one servo and a damaged one means several.
 * **one id at a time** (Dynamixel 1.0, which has no broadcast ping, and Feetech when its broadcast ping
   came back damaged): a PING per id, each waiting the reply timeout. A status packet that arrives after
-  its timeout is not lost: it is found among the stale bytes dropped before the next ping, and its id
-  is pinged again with a long timeout.
+  its timeout is not lost: every byte read from the port passes a tap that notes the id of each clean
+  status packet (the SDK skips a reply whose id is not the one it asked), and those ids are pinged again
+  with a long timeout.
 
 Two servos at one id and baud rate answer at once and garble each other (e-Manual: "If DYNAMIXELs with
 the same ID are connected, packet collision and network problems will occur"): every damaged status
@@ -83,7 +84,8 @@ class ProbeBus:
         self.backend = backend
         self.protocol = float(protocol)
         self.port_name = port_name
-        self.port = port_handler
+        self._inner_port = port_handler
+        self.port = _Tap(port_handler, wire.framing_for(backend, protocol))
         self.reply_timeout_ms = reply_timeout_ms
         self.retries = retries
         self.framing = wire.framing_for(backend, protocol)
@@ -183,16 +185,17 @@ class ProbeBus:
 
     def _ping_each(self, ids) -> tuple[dict[int, int | None], int]:
         answered: dict[int, int | None] = {}
-        late: set[int] = set()
         damaged = 0
+        self.port.seen.clear()
         for servo_id in ids:
-            late |= self._drop_stale()
+            self._drop_stale()
             outcome, number = self._ping_once(servo_id)
             if outcome == "ok":
                 answered[servo_id] = number
             elif outcome == "damaged":
                 damaged += 1
-        late |= self._drop_stale()
+        self._drop_stale()
+        late = {i for i in self.port.seen if i in ids}
         for servo_id in sorted(late - set(answered)):
             outcome, number = self._ping_once(servo_id, CONFIRM_TIMEOUT_MS)
             if outcome == "ok":
@@ -204,7 +207,12 @@ class ProbeBus:
         Dynamixel's ping returns the model number (2.0: in the status; 1.0: read at address 0); the Feetech
         SDK's assumes one byte order for every servo, so it is left to :meth:`model_number`."""
         with self._timeout(timeout_ms):
-            number, result, _error = self._guard(lambda: self._ph.ping(self.port, servo_id))
+            try:
+                number, result, _error = self._guard(lambda: self._ph.ping(self.port, servo_id))
+            except IndexError:  # dynamixel_sdk 1.0's ping indexes a model-number reply too short: a stale packet
+                self.port.is_using = False
+                self.port.seen.add(servo_id)  # it answered something: ask again with time to spare
+                return "silent", None
         if result == self.sdk.COMM_SUCCESS:
             return "ok", (number if self.backend == "dynamixel" else None)
         return ("damaged" if result == self.sdk.COMM_RX_CORRUPT else "silent"), None
@@ -270,7 +278,7 @@ class ProbeBus:
         return self.reply_timeout_ms if self.reply_timeout_ms is not None else 2 * _USB_LATENCY_MS + 2.0
 
     def _timeout(self, timeout_ms: float | None):
-        return _ReplyTimeout(self.port, timeout_ms if timeout_ms is not None else self.reply_timeout_ms)
+        return _ReplyTimeout(self._inner_port, timeout_ms if timeout_ms is not None else self.reply_timeout_ms)
 
     def _guard(self, call):
         try:
@@ -321,6 +329,36 @@ class ProbeBus:
         elif getattr(self.port, "ser", None) is not None:
             self.port.ser.reset_input_buffer()
         return ids
+
+
+class _Tap:
+    """The port handler, with every byte read from it parsed on the side: ``seen`` holds the id of each clean
+    status packet, whoever asked for it (a reply that came after its timeout included)."""
+
+    def __init__(self, inner: Any, framing: str) -> None:
+        self._inner = inner
+        self._framing = framing
+        self._pending = bytearray()
+        self.seen: set[int] = set()
+        self.is_using = False  # the SDK's lock lives on the object it talks to
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._inner, name)
+
+    def readPort(self, length: int):  # noqa: N802 (SDK name)
+        data = self._inner.readPort(length)
+        if data:
+            self._pending += bytes(data)
+            for raw, is_packet in wire.split_complete(self._pending, self._framing):
+                if is_packet:
+                    frame = wire.parse(raw, self._framing, status=True)
+                    if frame.checksum_ok:
+                        self.seen.add(frame.packet_id)
+        return data
+
+    def writePort(self, packet) -> int:  # noqa: N802
+        self._pending.clear()  # a new exchange: what was half-read belongs to the last one
+        return self._inner.writePort(packet)
 
 
 class _ReplyTimeout:

@@ -78,6 +78,7 @@ class SdkBus(Bus):
         self.models = dict(models)
         self.retries = int(retries)
         self.last_status_errors: dict[int, int] = {}  # servo id -> error byte of its last status packet
+        self.model_numbers: dict[int, int] = {}  # servo id -> the model number its last ping reported
         self._check_models()
         first = next(iter(self.models.values()))
         self._goal = (first.addr_goal_position, first.len_goal_position)
@@ -195,10 +196,11 @@ class SdkBus(Bus):
             self._before_transaction()
             with self._port_guard(servo_id):
                 self._drop_stale_input()
-                _model_number, result, error = self._ph.ping(self.port, servo_id)
+                model_number, result, error = self._ph.ping(self.port, servo_id)
             self._raise_on_port_failure(result, servo_id)
             if result == self.sdk.COMM_SUCCESS:
                 self.last_status_errors[servo_id] = error
+                self.model_numbers[servo_id] = model_number  # the SDKs read it with the ping (2.0: in the status)
                 return True
         return False
 

@@ -23,14 +23,16 @@ import numpy as np
 
 from gaitbot.bus import log as bus_log
 from gaitbot.bus.log import BusLog, RecordedPacket, RecordingError, parse_packet, read_header, typed_header
+from gaitbot.check.health import HealthReport, health_report
 from gaitbot.check.settings import SettingWrite, describe_settings, setting_write
 from gaitbot.check.trajectory import CheckReport, check_trajectory
 from gaitbot.robot.calibration import ticks_to_angles
 from gaitbot.robot.config import RobotConfig, shipped_config_dirs, shipped_config_names
+from gaitbot.robot.health import health_thresholds
 from gaitbot.servos import wire
 
 MAX_GAP_PERIODS = 1.5
-BUS_KIND_ORDER = ("packet", "ids", "timing", "status", "file", "config")
+BUS_KIND_ORDER = ("packet", "ids", "timing", "status", "health", "file", "config")
 _HEX_SHOWN = 48  # hex characters of a packet quoted in a message
 
 
@@ -43,8 +45,9 @@ class BusIssue:
     """A problem of the recorded bus traffic (not of a joint's motion).
 
     kind: "packet" (malformed), "ids" (missing/unknown/repeated id), "timing" (late frame, time
-    backwards), "status" (a servo reported an error), "file" (partial last line), "config"
-    (recording and config differ in a detail that does not change the checks).
+    backwards), "status" (a servo reported an error), "health" (a servo's temperature, voltage or load
+    read past a threshold: gaitbot.check.health), "file" (partial last line), "config" (recording and
+    config differ in a detail that does not change the checks).
     """
 
     kind: str
@@ -109,6 +112,8 @@ class RecordingReport:
     sample_t_s: tuple[float, ...]
     settings: tuple[SettingWrite, ...] = ()  # gain (and other setting) writes, in file order
     settings_text: tuple[str, ...] = ()  # the same, one line per register and value, for people
+    health: HealthReport | None = None  # the servo health reads of the run (gaitbot.check.health)
+    health_text: tuple[str, ...] = ()  # its extremes, for people
 
     @property
     def errors(self) -> tuple[BusIssue, ...]:
@@ -160,6 +165,7 @@ class RecordingReport:
             "frame_timing": asdict(self.timing),
             "bus_issues": [{**asdict(i), "message_line": i.describe()} for i in self.issues],
             "settings": [asdict(w) for w in self.settings],
+            "servo_health": self.health.to_dict() if self.health is not None else None,
             "joint_check": joint_violations,
         }
 
@@ -173,6 +179,7 @@ class RecordingReport:
                  f"{_count(self.issues, 'timing')} timing problems",
                  self.timing.describe(),
                  *(f"settings written: {line}" for line in self.settings_text),
+                 *self.health_text,
                  "",
                  "joint limits, goal ticks decoded to angles at the recorded send times:",
                  self.joints.format_text(max_per_kind)]
@@ -357,6 +364,10 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
     timing, timing_issues = _frame_timing(config.gait.rate_hz, np.array(timing_t), np.array(timing_line, dtype=int))
     issues += timing_issues
 
+    health = health_report(packets, wire.framing_for(config.bus.backend, config.bus.protocol), models,
+                           health_thresholds(config), names)
+    issues += [BusIssue("health", f.severity, f.line_no, f.t_s, f.message) for f in health.findings]
+
     t_s, lines, ticks = _motion_samples(config, np.array(frames_t), np.array(frames_line),
                                         np.array(frames_rows, dtype=float))
     angles_deg = np.degrees(ticks_to_angles(config, ticks))
@@ -369,7 +380,8 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
                            n_rx=sum(1 for p in packets if p.direction == "rx"), n_goal_frames=len(frames_t),
                            timing=timing, issues=tuple(issues), joints=joints,
                            sample_lines=tuple(int(x) for x in lines), sample_t_s=tuple(float(x) for x in t_s),
-                           settings=tuple(settings), settings_text=tuple(describe_settings(tuple(settings), models)))
+                           settings=tuple(settings), settings_text=tuple(describe_settings(tuple(settings), models)),
+                           health=health, health_text=tuple(health.lines(names)))
 
 
 def _id_label(servo_id: int, names: dict[int, str]) -> str:

@@ -1,0 +1,89 @@
+"""``gaitbot calibrate``: each joint's zero tick and direction measured on the robot, written to a calibration file.
+
+The person holds the robot (torque off) in its zero pose, then bends each joint in its positive direction
+when asked (gaitbot/stream/calibrate.py runs the steps; gaitbot/robot/joint_words.py says them in words).
+The file (gaitbot/robot/calibration_file.py, docs/file-formats.md) is checked against the config before it
+is written: a zero tick with which a configured limit falls outside the servo's range is refused with the
+range. Nothing is written to a servo but Torque Enable = 0.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+from gaitbot.app.hardware import serial_port, warn_about_latency
+from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
+from gaitbot.bus.factory import make_robot_bus
+from gaitbot.robot.calibration_file import (CalibrationFile, JointCalibration, apply_calibration,
+                                            calibration_path_for, write_calibration)
+from gaitbot.robot.joint_words import positive_motion
+from gaitbot.stream.calibrate import CalibrationJoint, CalibrationStopped, calibrate_session
+
+ZERO_POSE = ("Hold the robot in its zero pose: legs straight, feet flat and parallel, torso upright "
+             "(docs/bring-up.md has a picture). Press Enter.")
+BEND = "{joint}: {words}, by 20 degrees or more, and hold it there. Press Enter."
+QUESTION = "Turn torque off on {n} servos? The legs will go limp: hold the robot. [y/N] "
+
+
+def _check_output(out: Path) -> None:
+    if out.suffix != ".toml":
+        raise UsageError(f"-o {out}: a calibration file is TOML: the name must end in .toml "
+                         f"(e.g. {calibration_path_for('robot.toml').name}, found beside robot.toml by name)")
+    parent = out.parent if str(out.parent) else Path(".")
+    if out.is_dir() or not parent.is_dir() or not os.access(parent, os.W_OK):
+        raise UsageError(f"-o {out}: cannot write there (no such directory, or no permission)")
+
+
+def _wait_for_enter(step: str, words: str) -> None:
+    text = ZERO_POSE if step == "zero" else BEND.format(joint=step, words=words[:1].upper() + words[1:])
+    print(text, flush=True)
+    if not sys.stdin.readline():
+        raise CalibrationStopped("no answer on standard input (press Enter at each step); nothing written")
+
+
+def _confirm(yes: bool):
+    def confirm(n: int) -> bool:
+        if yes:
+            return True
+        print(QUESTION.format(n=n), end="", flush=True)
+        answer = sys.stdin.readline()
+        if not answer:
+            print()
+        return answer.strip().lower() in ("y", "yes")
+    return confirm
+
+
+def run(args) -> int:
+    config = load_robot(args.robot, None)  # measured as the config describes the servos, without any calibration
+    out = Path(args.output)
+    _check_output(out)
+    check_reply_timeout(args.reply_timeout_ms)
+    port = serial_port(config, args.port, dry_run=False)
+    warn_about_latency(port)
+    bus = make_robot_bus(config, port, reply_timeout_ms=args.reply_timeout_ms)
+    joints = [CalibrationJoint(j.name, j.id, j.model, j.min_deg, j.max_deg) for j in config.joints]
+    results = calibrate_session(bus, joints, ask=_wait_for_enter, confirm=_confirm(args.yes), words=positive_motion)
+    if results is None:
+        print(f"{config.name}: calibration cancelled: nothing was written, torque left as it was.")
+        return 0
+    calibrated = [JointCalibration(r.name, r.id, r.model_name, r.zero_tick, r.direction, round(r.moved_deg, 1))
+                  for r in results]
+    apply_calibration(config, CalibrationFile(out, config.name, tuple(calibrated)))  # refuses what cannot hold
+    write_calibration(out, config.name, calibrated,
+                      comment=f"gaitbot calibrate --robot {config.path}: zero ticks and directions of {config.name}'s "
+                              "servos,\nmeasured on the robot (docs/file-formats.md). Applied on top of the config by "
+                              "--calibration,\nor found beside the config as <config stem>.calibration.toml.")
+    print(f"{'joint':20s} {'id':>4s} {'zero tick':>9s} {'direction':>9s} {'bent deg':>8s}  was (config)")
+    by_name = {j.name: j for j in config.joints}
+    for r in results:
+        was = by_name[r.name]
+        print(f"{r.name:20s} {r.id:4d} {r.zero_tick:9d} {r.direction:+9d} {r.moved_deg:8.1f}  "
+              f"{was.zero_tick} / {was.direction:+d}")
+        for note in r.notes:
+            print(f"warning: {r.name}: {note}", file=sys.stderr)
+    print(f"wrote {out}: {len(results)} joints of {config.name}; torque stays off. Use it with --calibration {out}"
+          + ("" if out.resolve() == calibration_path_for(config.path).resolve() else
+             f", or name it {calibration_path_for(config.path)} to have it found beside the config"))
+    return 0
