@@ -12,7 +12,7 @@ order, and nothing else (vendor-facts.md section 7; LeRobot's ``setup_motor`` do
 3. ID = the new id, at the old id, not waited for (whether the servo answers as its old or its new self
    is not documented); then a PING at the new id confirms it;
 4. Baud Rate = the new rate's register value, at the new id, not waited for (the answer may come at either
-   rate); the host switches to the new rate;
+   rate); once the write has left the port (and 10 ms more) the host switches to the new rate;
 5. read back ID, Baud Rate and Model Number at the new id and rate; Feetech: Lock = 1 again (its
    power-on state; the id and rate written while it was 0 are saved).
 """
@@ -92,6 +92,7 @@ def assign_id_and_baud(probe: ProbeBus, found: ServoFound, model: ServoModel, ne
         servo_id = new_id
     if new_baudrate != found.baudrate:
         write("Baud Rate", baud.address, value, confirm=False)
+        probe.drain()  # the write must leave at the old rate before the host switches
         probe.set_baudrate(new_baudrate)
     try:
         got_id = probe.read(servo_id, servo_id_reg.address, 1)[0][0]

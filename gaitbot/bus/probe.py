@@ -40,6 +40,9 @@ _BROADCAST_MS_PER_SERVO = 3.0
 _USB_LATENCY_MS = 16.0
 #: A second look at a servo that answered late, or whose answer must be sure: this long per reply.
 CONFIRM_TIMEOUT_MS = 100.0
+#: A broadcast ping waits at least this long for a first reply, whatever the reply timeout: once per baud
+#: rate, and a servo missed there is a servo not found.
+FIRST_REPLY_MS = 100.0
 
 
 @dataclass(frozen=True)
@@ -117,6 +120,17 @@ class ProbeBus:
     def __exit__(self, *exc) -> None:
         self.close()
 
+    def drain(self, settle_s: float = 0.01) -> None:
+        """Wait until every byte written has left the port (tcdrain), then ``settle_s`` more: before the host
+        switches rate after a Baud Rate write, so the servo hears the whole write at the old rate."""
+        serial_port = getattr(self._inner_port, "ser", None)
+        if serial_port is not None:
+            try:
+                serial_port.flush()
+            except PORT_EXCEPTIONS as exc:
+                raise PortError(f"serial port {self.port_name} failed: {exc}") from exc
+        time.sleep(settle_s)
+
     def set_baudrate(self, baudrate: int) -> None:
         """Switch the host to ``baudrate``; PortError when the SDK or the adapter refuses it."""
         try:
@@ -162,7 +176,7 @@ class ProbeBus:
         self._write(packet)
         byte_ms = 10_000.0 / self.baudrate
         if all_at_once:  # one status packet's time, as for a ping of one servo
-            window_ms = 6 * byte_ms + self._reply_ms()
+            window_ms = 6 * byte_ms + max(self._reply_ms(), FIRST_REPLY_MS)
         else:
             window_ms = (_BROADCAST_STATUS_BYTES * (max_servo_id(self.backend, self.protocol) + 1) * byte_ms
                          + _BROADCAST_MS_PER_SERVO * (max_servo_id(self.backend, self.protocol) + 1)
@@ -217,8 +231,9 @@ class ProbeBus:
             return "ok", (number if self.backend == "dynamixel" else None)
         return ("damaged" if result == self.sdk.COMM_RX_CORRUPT else "silent"), None
 
-    def ping(self, servo_id: int, timeout_ms: float | None = None) -> bool:
-        """Whether ``servo_id`` answers a PING (with the retries of every read)."""
+    def ping(self, servo_id: int, timeout_ms: float = CONFIRM_TIMEOUT_MS) -> bool:
+        """Whether ``servo_id`` answers a PING (with the retries of every read; a confirmation, so it waits
+        CONFIRM_TIMEOUT_MS, not the search's reply timeout)."""
         for _ in range(1 + self.retries):
             self._drop_stale()
             if self._ping_once(servo_id, timeout_ms)[0] == "ok":
@@ -227,11 +242,13 @@ class ProbeBus:
 
     # --- registers --------------------------------------------------------------------------
     def read(self, servo_id: int, address: int, length: int) -> tuple[bytes, int]:
-        """(``length`` bytes at ``address``, the status error byte); ServoTimeout after the retries."""
+        """(``length`` bytes at ``address``, the status error byte); ServoTimeout after the retries. Reads and
+        confirmed writes wait CONFIRM_TIMEOUT_MS for their status packet: they are few, and must not fail."""
         result = self.sdk.COMM_SUCCESS
         for _ in range(1 + self.retries):
             self._drop_stale()
-            data, result, error = self._guard(lambda: self._ph.readTxRx(self.port, servo_id, address, length))
+            with self._timeout(CONFIRM_TIMEOUT_MS):
+                data, result, error = self._guard(lambda: self._ph.readTxRx(self.port, servo_id, address, length))
             if result == self.sdk.COMM_SUCCESS and len(data) >= length:
                 return bytes(data[:length]), error
         raise ServoTimeout(f"servo {servo_id} on {self.port_name} at {self.baudrate} baud did not answer a read of "
@@ -250,8 +267,9 @@ class ProbeBus:
         result = self.sdk.COMM_SUCCESS
         for _ in range(1 + self.retries):
             self._drop_stale()
-            result, error = self._guard(lambda: self._ph.writeTxRx(self.port, servo_id, address, len(data),
-                                                                    list(data)))
+            with self._timeout(CONFIRM_TIMEOUT_MS):
+                result, error = self._guard(lambda: self._ph.writeTxRx(self.port, servo_id, address, len(data),
+                                                                        list(data)))
             if result == self.sdk.COMM_SUCCESS:
                 return error
         raise ServoTimeout(f"servo {servo_id} on {self.port_name} did not confirm writing to address {address} "
@@ -294,18 +312,23 @@ class ProbeBus:
             raise PortError(f"serial port {self.port_name} failed: {exc}") from exc
 
     def _listen(self, window_ms: float, quiet_ms: float | None) -> bytes:
-        """Every byte within ``window_ms``; with ``quiet_ms``, stop once the line has been quiet that long."""
+        """Every byte within ``window_ms``; with ``quiet_ms``, stop once the line has been quiet that long after
+        a reply, or after FIRST_REPLY_MS (at least ``quiet_ms``) if nothing came at all."""
         data = bytearray()
         self.port.setPacketTimeoutMillis(window_ms)
-        last_s = time.monotonic()
+        start_s = last_s = time.monotonic()
+        first_s = None if quiet_ms is None else max(quiet_ms, FIRST_REPLY_MS) / 1000.0
         while True:
             available = self._guard(self.port.getBytesAvailable)
+            now_s = time.monotonic()
             if available:
                 data += bytes(self._guard(lambda: self.port.readPort(available)))
-                last_s = time.monotonic()
+                last_s = now_s
             elif self.port.isPacketTimeout():
                 return bytes(data)
-            elif quiet_ms is not None and (time.monotonic() - last_s) * 1000.0 > quiet_ms:
+            elif quiet_ms is not None and data and (now_s - last_s) * 1000.0 > quiet_ms:
+                return bytes(data)
+            elif first_s is not None and not data and now_s - start_s > first_s:
                 return bytes(data)
             else:
                 time.sleep(0.0002)

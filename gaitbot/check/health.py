@@ -59,7 +59,7 @@ class HealthReport:
         out = [f"servo health over {self.n_readings} reads:"]
         h, v, p = self.hottest, self.lowest_voltage, self.peak_load
         out.append(f"  hottest servo: {who(h)} at {h.reading.temperature_c:g} °C, t={h.t_s:.3f} s (line {h.line_no})")
-        out.append(f"  lowest voltage: {v.reading.voltage_v:g} V at {who(v)}, t={v.t_s:.3f} s (line {v.line_no})")
+        out.append(f"  lowest voltage: {v.reading.voltage_v:.1f} V at {who(v)}, t={v.t_s:.3f} s (line {v.line_no})")
         if p is not None:
             out.append(f"  peak load: {abs(p.reading.load_pct):g} % at {who(p)}, t={p.t_s:.3f} s (line {p.line_no})")
         else:
@@ -124,11 +124,11 @@ def _judge(report: HealthReport, r: RecordedReading, t: HealthThresholds | None,
         ("error", "temperature-stop", reading.temperature_c >= t.stop_temperature_c,
          f"{who} at {reading.temperature_c:g} °C, at or above the stop temperature {t.stop_temperature_c:g} °C"),
         ("error", "voltage-stop", reading.voltage_v <= t.stop_voltage_v,
-         f"{who} input voltage {reading.voltage_v:g} V, at or under the stop voltage {t.stop_voltage_v:g} V"),
+         f"{who} input voltage {reading.voltage_v:.1f} V, at or under the stop voltage {t.stop_voltage_v:.1f} V"),
         ("warning", "temperature", reading.temperature_c >= t.warn_temperature_c,
          f"{who} at {reading.temperature_c:g} °C, at or above the warning temperature {t.warn_temperature_c:g} °C"),
         ("warning", "voltage", reading.voltage_v <= t.warn_voltage_v,
-         f"{who} input voltage {reading.voltage_v:g} V, at or under the warning voltage {t.warn_voltage_v:g} V"),
+         f"{who} input voltage {reading.voltage_v:.1f} V, at or under the warning voltage {t.warn_voltage_v:.1f} V"),
         ("warning", "load", reading.load_pct is not None and abs(reading.load_pct) >= t.warn_load_pct,
          f"{who} load {abs(reading.load_pct or 0):g} %, at or above the warning load {t.warn_load_pct:g} %"),
     )

@@ -188,6 +188,8 @@ class RecordingReport:
             found = [i for i in self.issues if i.kind == kind]
             if not found:
                 continue
+            if kind == "health":  # a stop threshold reached matters more than the warnings before it
+                found.sort(key=lambda i: (i.severity != "error", i.line_no))
             lines += ["", f"{kind} ({len(found)}):"]
             lines += [f"  {i.severity}: {i.describe()}" for i in found[:max_per_kind]]
             if len(found) > max_per_kind:

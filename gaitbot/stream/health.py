@@ -97,15 +97,15 @@ class HealthMonitor:
                                   f"{t.stop_temperature_c:g} °C{own}; let it cool before walking again",
                                   servo_id=servo_id, kind="temperature", reading=reading)
         if reading.voltage_v <= t.stop_voltage_v:
-            raise ServoHealthStop(f"{who} has {reading.voltage_v:g} V input voltage, at or under its stop voltage "
-                                  f"{t.stop_voltage_v:g} V; charge or change the battery",
+            raise ServoHealthStop(f"{who} has {reading.voltage_v:.1f} V input voltage, at or under its stop voltage "
+                                  f"{t.stop_voltage_v:.1f} V; charge or change the battery",
                                   servo_id=servo_id, kind="voltage", reading=reading)
         if reading.temperature_c >= t.warn_temperature_c:
             self._warn(servo_id, "temperature", f"{who} at {reading.temperature_c:g} °C (warning at "
                                                 f"{t.warn_temperature_c:g}, stop at {t.stop_temperature_c:g} °C)")
         if reading.voltage_v <= t.warn_voltage_v:
-            self._warn(servo_id, "voltage", f"{who} input voltage {reading.voltage_v:g} V (warning at "
-                                            f"{t.warn_voltage_v:g}, stop at {t.stop_voltage_v:g} V)")
+            self._warn(servo_id, "voltage", f"{who} input voltage {reading.voltage_v:.1f} V (warning at "
+                                            f"{t.warn_voltage_v:.1f}, stop at {t.stop_voltage_v:.1f} V)")
         if reading.load_pct is not None and abs(reading.load_pct) >= t.warn_load_pct:
             self._warn(servo_id, "load", f"{who} load {abs(reading.load_pct):g} % (warning at {t.warn_load_pct:g} %)")
 
@@ -125,7 +125,7 @@ class HealthMonitor:
         if self.hottest is not None:
             parts.append(f"hottest {self.label(self.hottest.servo_id)} {self.hottest.value:g} °C")
         if self.lowest_voltage is not None:
-            parts.append(f"lowest voltage {self.lowest_voltage.value:g} V at {self.label(self.lowest_voltage.servo_id)}")
+            parts.append(f"lowest voltage {self.lowest_voltage.value:.1f} V at {self.label(self.lowest_voltage.servo_id)}")
         if self.peak_load is not None:
             parts.append(f"peak load {self.peak_load.value:g} % at {self.label(self.peak_load.servo_id)}")
         return f"servo health over {self.readings} reads: " + ", ".join(parts)
