@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 from gaitbot.robot.config import ConfigError, RobotConfig
 from gaitbot.servos import ASSUMED_RETURN_DELAY_S, BACKENDS, has_sync_read, wire
+from gaitbot.servos.health import health_block
 from gaitbot.servos.models import ServoModel, servo_model
 
 BITS_PER_BYTE = 10
@@ -63,6 +64,20 @@ def frame_budget(backend: str, protocol: float, model: ServoModel | str, n_servo
         request = (addressed + n_servos) if sync_read else addressed * n_servos
         read = request + n_servos * status
     return FrameBudget(write, read, n_servos if read_back else 0, return_delay_s, int(baudrate))
+
+
+def one_servo_read_back_bytes(backend: str, protocol: float, model: ServoModel | str, health: bool) -> int:
+    """Bytes on the wire of the per-frame read-back of ONE servo (the session reads one servo a frame, in turn):
+    its present position (a sync read of one where the protocol has one, else a READ), or with ``health`` its
+    whole health block in one READ (gaitbot.servos.health: X 21 bytes, AX/STS/SCS 8, XL-320 10)."""
+    model = servo_model(model) if isinstance(model, str) else model
+    framing = wire.framing_for(backend, protocol)
+    addressed = wire.PACKET_OVERHEAD_BYTES[framing] + 2 * wire.ADDRESS_BYTES[framing]
+    status = wire.STATUS_OVERHEAD_BYTES[framing]
+    if health:
+        return addressed + status + health_block(model).length
+    sync_read = has_sync_read(backend, protocol, model.byte_order)
+    return addressed + (1 if sync_read else 0) + status + model.len_present_position
 
 
 def max_rate_hz(backend: str, protocol: float, model: ServoModel | str, n_servos: int, baudrate: int,

@@ -76,8 +76,9 @@ class Layout:
     eeprom_end: int  # first RAM address
     lock_addr: int | None  # Feetech's Lock flag
     temperature_limit_addr: int
-    min_voltage_addr: int
-    max_voltage_addr: int
+    min_voltage: tuple[int, int]  # Min Voltage Limit (address, size)
+    max_voltage: tuple[int, int]
+    baud_addr: int
     initial: tuple[tuple[int, int, int], ...]
 
     @classmethod
@@ -94,11 +95,13 @@ class Layout:
         return cls(table["ID"].address, table["Return Delay Time"].address, table["Status Return Level"].address,
                    table["Moving"].address, hardware.address if hardware is not None else None, bits,
                    vendor(model.family).EEPROM_END[model.name], lock.address if lock is not None else None,
-                   temperature.address, table["Min Voltage Limit"].address, table["Max Voltage Limit"].address,
+                   temperature.address, tuple(table["Min Voltage Limit"][:2]), tuple(table["Max Voltage Limit"][:2]),
+                   table["Baud Rate"].address,
                    tuple((r.address, r.size, r.factory) for r in table.values() if r.factory is not None))
 
 
 LAYOUTS = {name: Layout.of(model) for name, model in SERVO_MODELS.items()}
+_REGISTERS = {name: model.control_table for name, model in SERVO_MODELS.items()}
 
 
 @dataclass(eq=False)
@@ -117,10 +120,15 @@ class Servo:
     rate_blind: bool = False  # made for a rate its register cannot hold: hears any rate
     moved_at_s: float | None = None  # None: time has not started for it (no packet yet)
     pending_error: int | None = None  # the error of the next status packet (a refused write)
+    shown: tuple | None = None  # (temperature, voltage, torque, load) the registers show now
 
     @property
     def layout(self) -> Layout:
         return LAYOUTS[self.model.name]
+
+    @property
+    def block(self):
+        return health_block(self.model)
 
     @property
     def servo_id(self) -> int:
@@ -131,7 +139,7 @@ class Servo:
         return MockPort.servo_rate(self.model, self.table)
 
     def register(self, name: str) -> int:
-        r = self.model.control_table[name]
+        r = _REGISTERS[self.model.name][name]
         return int.from_bytes(self.table[r.address:r.address + r.size], self.model.byte_order)
 
 
@@ -238,6 +246,7 @@ class EmulatedChain(MockPort):
         first = self.units[0].model if self.units else None
         factory_v = (health_block(first).voltage.factory / 10.0) if first is not None else 12.0
         self.supply_v = config.supply_v if config.supply_v is not None else factory_v
+        self._supply_v = self.supply_v
         if config.one_at_a_time:
             self.connect_only(0)
         self._route()
@@ -268,7 +277,14 @@ class EmulatedChain(MockPort):
         return unit.connected and (unit.rate_blind or rates_match(unit.rate, self.line_baud))
 
     def _route(self) -> None:
-        """Map the ids of the servos that hear the line to them; a second servo at an id waits in a layer."""
+        """Map the ids of the servos that hear the line to them; a second servo at an id waits in a layer.
+        Rebuilt only when a servo's id, rate or plug, or the line's rate, changed."""
+        signature = (self.line_baud, *((u.connected, u.table[u.layout.id_addr], u.table[u.layout.baud_addr])
+                                       for u in self.units))
+        if signature == getattr(self, "_route_signature", None):
+            self._use(self._primary)
+            return
+        self._route_signature = signature
         primary: dict[int, Servo] = {}
         self._layers: list[dict[int, Servo]] = []
         for unit in self.units:
@@ -328,6 +344,7 @@ class EmulatedChain(MockPort):
                         name not in ("Goal Position", "Present Position"):
                     fresh[register.address:register.address + register.size] = bytes(register.size)
             unit.table[:] = fresh
+            unit.shown = None
         self._route()
 
     # --- time and faults ------------------------------------------------------------------
@@ -369,13 +386,14 @@ class EmulatedChain(MockPort):
 
     def _natural_kinds(self, unit: Servo) -> set[str]:
         """What the servo itself reports: overheating at its Temperature Limit, input voltage outside its limits."""
-        layout, kinds = unit.layout, set()
-        if unit.temperature_c >= unit.table[layout.temperature_limit_addr]:
+        layout, table, order = unit.layout, unit.table, unit.model.byte_order
+        kinds = set()
+        if unit.temperature_c >= table[layout.temperature_limit_addr]:
             kinds.add("overheating")
-        volts = self.supply_now_v()
-        min_v = unit.register("Min Voltage Limit") / 10.0
-        max_v = unit.register("Max Voltage Limit") / 10.0
-        if volts < min_v or volts > max_v:
+        tenths = self._supply_v * 10
+        (low, low_size), (high, high_size) = layout.min_voltage, layout.max_voltage
+        if tenths < int.from_bytes(table[low:low + low_size], order) or \
+                tenths > int.from_bytes(table[high:high + high_size], order):
             kinds.add("voltage")
         return kinds
 
@@ -443,20 +461,24 @@ class EmulatedChain(MockPort):
         self._warm(unit, dt_s, torque)
 
     def _warm(self, unit: Servo, dt_s: float, torque: bool) -> None:
-        heat = self.config.heat
-        load = unit.load_pct / 100.0 if torque else 0.0
-        equilibrium_c = heat.ambient_c + heat.heat_c_per_s * load * load * heat.cool_time_s
-        unit.temperature_c = equilibrium_c + (unit.temperature_c - equilibrium_c) * math.exp(-dt_s / heat.cool_time_s)
-        block, table = health_block(unit.model), unit.table
-        table[block.temperature.address] = max(0, min(255, int(round(unit.temperature_c))))
-        volts = int(round(self.supply_now_v() * 10))
+        if dt_s > 0.0:
+            heat = self.config.heat
+            load = unit.load_pct / 100.0 if torque else 0.0
+            equilibrium_c = heat.ambient_c + heat.heat_c_per_s * load * load * heat.cool_time_s
+            unit.temperature_c = equilibrium_c + (unit.temperature_c - equilibrium_c) * math.exp(
+                -dt_s / heat.cool_time_s)
+        shown = (int(round(unit.temperature_c)), int(round(self._supply_v * 10)), torque, unit.load_pct)
+        if shown == unit.shown:
+            return  # the registers already say so
+        unit.shown = shown
+        block, table, order = unit.block, unit.table, unit.model.byte_order
+        table[block.temperature.address] = max(0, min(255, shown[0]))
         size = block.voltage.size
         table[block.voltage.address:block.voltage.address + size] = \
-            max(0, min(volts, (1 << (8 * size)) - 1)).to_bytes(size, unit.model.byte_order)
+            max(0, min(shown[1], (1 << (8 * size)) - 1)).to_bytes(size, order)
         if block.load is not None:
             raw = encode_load(unit.load_pct if torque else 0.0, block.load_encoding, block.load.size)
-            table[block.load.address:block.load.address + block.load.size] = \
-                raw.to_bytes(block.load.size, unit.model.byte_order)
+            table[block.load.address:block.load.address + block.load.size] = raw.to_bytes(block.load.size, order)
 
     # --- instruction handling (MockPort's, extended) --------------------------------------
     def _answer(self, raw: bytes) -> None:
@@ -466,6 +488,7 @@ class EmulatedChain(MockPort):
         self._route()
         if frame.checksum_ok and self._hand_grabbed_s is not None:
             self._move_hand(frame)
+        self._supply_v = self.supply_now_v()
         for unit in self.units:
             self._advance_unit(unit)
         self._apply_error_faults()

@@ -75,8 +75,9 @@ class HealthReport:
 
 
 def health_report(packets, framing: str, models: dict[int, ServoModel], thresholds: dict[int, HealthThresholds],
-                  names: dict[int, str]) -> HealthReport:
-    """Decode every health read among ``packets`` (the recording check's parsed packets, in file order)."""
+                  names: dict[int, str], collect: list[RecordedReading] | None = None) -> HealthReport:
+    """Decode every health read among ``packets`` (the recording check's parsed packets, in file order);
+    ``collect`` (a list) receives every reading, for a plot."""
     blocks = {servo_id: health_block(model) for servo_id, model in models.items()}
     asked: dict[int, bool] = {}
     report = HealthReport()
@@ -98,6 +99,8 @@ def health_report(packets, framing: str, models: dict[int, ServoModel], threshol
             continue
         found = RecordedReading(p.line_no, p.t_s, decode_health(block, servo_id, bytes(pk.data[:block.length])))
         _take(report, found)
+        if collect is not None:
+            collect.append(found)
         _judge(report, found, thresholds.get(servo_id), names, warned)
     return report
 
