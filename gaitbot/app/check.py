@@ -45,7 +45,8 @@ def _check_trajectory_file(args, path: Path, margin: float) -> int:
 
 
 def _check_recording(args, path: Path, margin: float) -> int:
-    config = robot_for_recording(path, args.robot, lambda robot: load_robot(robot, getattr(args, "calibration", None)))
+    calibration = getattr(args, "calibration", None)
+    config = robot_for_recording(path, args.robot, lambda robot: load_robot(robot, calibration))
     report = check_recording(config, path, margin, allow_partial_last_line=bool(getattr(args, "allow_partial", False)))
     if args.json:
         print(json.dumps({**report.to_dict(), "config": str(config.path)}, indent=2))

@@ -85,11 +85,12 @@ def run(args) -> int:
     print(f"{'id':>3s} {'baud':>9s} {'model':11s} {'fw':>4s} {'ticks':>6s} {'joint':18s} {'angle':>7s} "
           f"{'volts':>5s} {'temp':>4s} {'load':>6s} {'torque':6s} hardware errors")
     for r in rows:
-        print(f"{r['id']:3d} {r['baudrate']:9,d} {_text(r['model'] or r['model_number']):11s} {_text(r['firmware']):>4s} "
-              f"{_text(r['position_ticks']):>6s} {_text(r['joint']):18s} {_text(r['angle_deg'], '{:.1f}'):>7s} "
-              f"{_text(r['voltage_v'], '{:.1f}'):>5s} {_text(r['temperature_c'], '{:.0f}'):>4s} "
-              f"{_text(r['load_pct'], '{:.1f}%'):>6s} {_text(r['torque']):6s} {', '.join(r['hardware_errors']) or 'none'}"
-              + "".join(f"; {p}" for p in r["problems"]))
+        errors = ", ".join(r["hardware_errors"]) or "none"
+        print(f"{r['id']:3d} {r['baudrate']:9,d} {_text(r['model'] or r['model_number']):11s} "
+              f"{_text(r['firmware']):>4s} {_text(r['position_ticks']):>6s} {_text(r['joint']):18s} "
+              f"{_text(r['angle_deg'], '{:.1f}'):>7s} {_text(r['voltage_v'], '{:.1f}'):>5s} "
+              f"{_text(r['temperature_c'], '{:.0f}'):>4s} {_text(r['load_pct'], '{:.1f}%'):>6s} {_text(r['torque']):6s} "
+              f"{errors}" + "".join(f"; {p}" for p in r["problems"]))
     if not rows:
         print("no servo answered")
     for rate, n in damaged.items():

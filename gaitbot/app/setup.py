@@ -46,8 +46,9 @@ def run(args) -> int:
     baud = config.bus.baudrate
     for joint in joints:
         if baud_register_value(joint.model.name, baud) is None:
+            held = _rates(baud_rates(joint.model.name).values())
             raise UsageError(f"{config.path}: bus.baudrate: a {joint.model.name} ({joint.name}) cannot run at "
-                             f"{baud:,} baud (its Baud Rate register holds {_rates(baud_rates(joint.model.name).values())})")
+                             f"{baud:,} baud (its Baud Rate register holds {held})")
     check_reply_timeout(args.reply_timeout_ms)
     port = serial_port(config, args.port, dry_run=False)
     warn_about_latency(port)
@@ -74,8 +75,8 @@ def run(args) -> int:
                                  f"connect only the servo for {joint.name} and run gaitbot setup --joint {joint.name}; "
                                  "nothing written")
             if not found:
-                raise NoServo(f"setup of {joint.name}: no servo answers at any of {_rates(rates)} baud; check its power "
-                              "and cable (and that it is a " + model.name + ")")
+                raise NoServo(f"setup of {joint.name}: no servo answers at any of {_rates(rates)} baud; check its "
+                              f"power and cable (and that it is a {model.name})")
             servo = found[0]
             if servo.model_name != model.name:
                 raise UsageError(f"setup of {joint.name} refused: the servo connected is a "

@@ -113,5 +113,5 @@ class Bus(ABC):
         self.close()
 
 
-__all__ = ["Bus", "HealthReading", "BusError", "PortError", "ServoTimeout", "ServoLate", "CorruptReplies", "ServoStatusError",
-           "RegisterWrite"]
+__all__ = ["Bus", "HealthReading", "BusError", "PortError", "ServoTimeout", "ServoLate", "CorruptReplies",
+           "ServoStatusError", "RegisterWrite"]

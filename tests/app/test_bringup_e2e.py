@@ -271,6 +271,10 @@ def test_a_servo_heating_past_its_limit_stops_the_walk_safely_and_check_reports_
     assert check.returncode == 1
     assert f"hottest servo: servo {knee.id} (knee_pitch_left) at {stop_c} °C" in check.stdout
     assert f"servo {knee.id} (knee_pitch_left) at {stop_c} °C, at or above the stop temperature" in check.stdout
+    as_json = subprocess.run([sys.executable, "-m", "gaitbot.app.cli", "check", str(record), "--json"],
+                             capture_output=True, text=True, timeout=TIMEOUT_S, cwd=REPO_ROOT)
+    hottest = json.loads(as_json.stdout)["servo_health"]["hottest"]
+    assert (hottest["id"], hottest["temperature_c"]) == (knee.id, stop_c)
 
 
 @pytest.mark.parametrize("protocol", ["dxl2", "dxl1", "feetech"])
