@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+import textwrap
 
 from gaitbot import __version__
 from gaitbot.bus.base import BusError
@@ -30,8 +31,8 @@ def _calibration(p: argparse.ArgumentParser) -> None:
 
 def _described(sub, name: str, help: str, description: str, examples: str) -> argparse.ArgumentParser:
     """A subcommand with a description and examples in its --help."""
-    return sub.add_parser(name, help=help, description=description, epilog="examples:\n" + examples,
-                          formatter_class=argparse.RawDescriptionHelpFormatter)
+    return sub.add_parser(name, help=help, description=textwrap.fill(description, 100),
+                          epilog="examples:\n" + examples, formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
 def _walk_inputs(p: argparse.ArgumentParser) -> None:
