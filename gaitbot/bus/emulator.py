@@ -602,8 +602,7 @@ class EmulatedChain(MockPort):
         if frame.instruction != wire.INST_SYNC_WRITE:
             return
         address, _ = self._address_and_rest(frame.params)
-        first = next(iter(self.models.values()))
-        if address == first.addr_goal_position:
+        if self.units and address == self.units[0].model.addr_goal_position:  # whoever hears it
             self.goal_frames += 1
             if self.goal_log is not None:
                 self.goal_log.log("tx", raw)
