@@ -41,8 +41,8 @@ _USB_LATENCY_MS = 16.0
 #: A second look at a servo that answered late, or whose answer must be sure: this long per reply.
 CONFIRM_TIMEOUT_MS = 100.0
 #: A broadcast ping waits at least this long for a first reply, whatever the reply timeout: once per baud
-#: rate, and a servo missed there is a servo not found.
-FIRST_REPLY_MS = 100.0
+#: rate, and a servo missed there is a servo not found (the SDK's own window is longer still).
+FIRST_REPLY_MS = 250.0
 
 
 @dataclass(frozen=True)
@@ -199,16 +199,15 @@ class ProbeBus:
 
     def _ping_each(self, ids) -> tuple[dict[int, int | None], int]:
         answered: dict[int, int | None] = {}
-        damaged = 0
         self.port.seen.clear()
+        self.port.damaged = 0
         for servo_id in ids:
             self._drop_stale()
             outcome, number = self._ping_once(servo_id)
             if outcome == "ok":
                 answered[servo_id] = number
-            elif outcome == "damaged":
-                damaged += 1
         self._drop_stale()
+        damaged = self.port.damaged  # every garbled reply read, in time or late (the tap sees them all)
         late = {i for i in self.port.seen if i in ids}
         for servo_id in sorted(late - set(answered)):
             outcome, number = self._ping_once(servo_id, CONFIRM_TIMEOUT_MS)
@@ -363,6 +362,7 @@ class _Tap:
         self._framing = framing
         self._pending = bytearray()
         self.seen: set[int] = set()
+        self.damaged = 0  # status packets whose checksum/CRC failed: two servos answering at once
         self.is_using = False  # the SDK's lock lives on the object it talks to
 
     def __getattr__(self, name: str) -> Any:
@@ -377,6 +377,8 @@ class _Tap:
                     frame = wire.parse(raw, self._framing, status=True)
                     if frame.checksum_ok:
                         self.seen.add(frame.packet_id)
+                    else:
+                        self.damaged += 1
         return data
 
     def writePort(self, packet) -> int:  # noqa: N802

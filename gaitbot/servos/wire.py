@@ -73,6 +73,8 @@ def crc16(data: bytes) -> int:
 
 def stuff(payload: bytes) -> bytes:
     """Add a 0xFD after every FF FF FD so data can never look like a packet header."""
+    if _STUFF_PATTERN not in payload:
+        return bytes(payload)  # nothing to stuff: most packets (and the byte loop below is slow)
     out = bytearray()
     for byte in payload:
         out.append(byte)
@@ -83,6 +85,8 @@ def stuff(payload: bytes) -> bytes:
 
 def unstuff(payload: bytes) -> bytes:
     """Inverse of stuff(): drop the 0xFD that follows each FF FF FD."""
+    if _STUFF_PATTERN not in payload:
+        return bytes(payload)
     out = bytearray()
     i = 0
     while i < len(payload):
