@@ -322,7 +322,8 @@ def _summary(joint, t, angle_deg, t_vel, vel, t_acc, acc, violations, lo, hi, v_
         max_acceleration_dps2=float(a_lim), verdict=verdict)
 
 
-def trajectory_angles_deg(config: RobotConfig, angles_rad) -> np.ndarray:
-    """(N, n_joints) degrees for every joint of the config from (N, 6) walking angles in radians
-    (e.g. ``Trajectory.angles_rad``); held joints at their hold_deg. Feed this to check_trajectory."""
-    return np.degrees(full_angles_rad(config, angles_rad))
+def trajectory_angles_deg(config: RobotConfig, angles_rad, names=None) -> np.ndarray:
+    """(N, n_joints) degrees for every joint of the config from (N, J) angles in radians of the
+    ``names`` joints (default: the moving joints; e.g. ``Trajectory.angles_rad`` and ``.joints``); held
+    joints at their hold_deg. Feed this to check_trajectory."""
+    return np.degrees(full_angles_rad(config, angles_rad, names))

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from gaitbot.fields import FieldError, Fields, kind, read_toml
-from gaitbot.gait.trajectory import WALKING_JOINTS
+from gaitbot.gait.joints import LEG_JOINTS, PITCH_JOINTS, PITCH_KINDS, canonical, is_leg_joint, mirror, split_joint
 from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
 from gaitbot.robot.gains import GainError, gain_for_error
 from gaitbot.servos import BACKENDS, dynamixel, feetech, max_servo_id
@@ -147,7 +147,8 @@ class ServoSettings:
 
 @dataclass(frozen=True)
 class RobotConfig:
-    """A whole robot: joints are the walking joints in WALKING_JOINTS order, then the held joints."""
+    """A whole robot: joints are the moving joints in canonical order (gaitbot.gait.joints), then the
+    held ones (``hold_deg``) in canonical order; the bus addresses them in this order."""
 
     path: Path
     name: str
@@ -161,11 +162,22 @@ class RobotConfig:
 
     @property
     def walking_joints(self) -> tuple[JointConfig, ...]:
-        return self.joints[: len(WALKING_JOINTS)]
+        """The joints the gait moves (no ``hold_deg``), in canonical order."""
+        return tuple(j for j in self.joints if j.hold_deg is None)
 
     @property
     def held_joints(self) -> tuple[JointConfig, ...]:
-        return self.joints[len(WALKING_JOINTS):]
+        return tuple(j for j in self.joints if j.hold_deg is not None)
+
+    @property
+    def walking_joint_names(self) -> tuple[str, ...]:
+        return tuple(j.name for j in self.walking_joints)
+
+    @property
+    def is_3d(self) -> bool:
+        """True when the legs move in roll as well as pitch (hip and ankle roll joints that walk):
+        such a robot can shift its weight sideways over one foot; a pitch-only one needs a boom."""
+        return "hip_roll_left" in self.walking_joint_names and "ankle_roll_left" in self.walking_joint_names
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -179,7 +191,7 @@ class RobotConfig:
     @cached_property
     def calibration(self) -> Calibration:
         """Angles <-> ticks for every joint, built once per config."""
-        return Calibration.of(self.joints, len(WALKING_JOINTS))
+        return Calibration.of(self.joints)
 
     @property
     def models_by_id(self) -> dict[int, ServoModel]:
@@ -371,29 +383,47 @@ class _Reader(Fields):
                            torque_off_on_exit=torque_off)
 
     def joints(self, data: dict, bus: BusSettings) -> tuple[JointConfig, ...]:
+        """Any mirrored set of leg joints that includes both legs' pitch joints; the moving ones first."""
         if "joints" not in data:
-            raise self.fail("joints", f"missing section (expected [joints.<name>] for {', '.join(WALKING_JOINTS)})")
+            raise self.fail("joints", f"missing section (expected [joints.<name>] for at least {', '.join(PITCH_JOINTS)})")
         tables = data["joints"]
         if not isinstance(tables, dict):
             raise self.fail("joints", f"must be tables [joints.<name>], got {kind(tables)}")
-        for name in WALKING_JOINTS:
+        for name in PITCH_JOINTS:
             if name not in tables:
-                others = [n for n in tables if n not in WALKING_JOINTS]
+                others = [n for n in tables if not is_leg_joint(n)]
                 close = difflib.get_close_matches(name, others, n=1)
                 hint = f"; is {close[0]!r} a typo of it?" if close else ""
-                raise self.fail(f"joints.{name}", f"missing walking joint (all of {', '.join(WALKING_JOINTS)} "
+                raise self.fail(f"joints.{name}", f"missing walking joint (all of {', '.join(PITCH_JOINTS)} "
                                                   f"are required{hint})")
-        order = list(WALKING_JOINTS) + [n for n in tables if n not in WALKING_JOINTS]
-        joints = tuple(self.joint(name, tables[name], bus) for name in order)
-        self.bus_wide_checks(joints, bus)
-        return joints
+        for name in tables:
+            if not is_leg_joint(name):
+                close = difflib.get_close_matches(name, LEG_JOINTS, n=1)
+                hint = f"did you mean {close[0]!r}? " if close else ""
+                raise self.fail(f"joints.{name}", f"unknown joint ({hint}allowed: {', '.join(LEG_JOINTS)})")
+        for name in canonical(tables):
+            if mirror(name) not in tables:
+                raise self.fail(f"joints.{mirror(name)}", f"missing: joints.{name} has no mirror on the other leg "
+                                                          f"(both legs must have the same joints)")
+        joints = {name: self.joint(name, tables[name], bus) for name in canonical(tables)}
+        for name, joint in joints.items():
+            other = joints[mirror(name)]
+            if joint.hold_deg is None and other.hold_deg is not None:
+                raise self.fail(f"joints.{name}.hold_deg", f"missing: joints.{other.name} is held at "
+                                                           f"{other.hold_deg:g} deg, so its mirror must be held too "
+                                                           f"(or remove hold_deg from both to walk with them)")
+        moving = [j for j in joints.values() if j.hold_deg is None]
+        held = [j for j in joints.values() if j.hold_deg is not None]
+        ordered = tuple(moving + held)
+        self.bus_wide_checks(ordered, bus)
+        return ordered
 
     def joint(self, name: str, t: Any, bus: BusSettings) -> JointConfig:
         f = f"joints.{name}"
         if not isinstance(t, dict):
             raise self.fail(f, f"must be a table [{f}], got {kind(t)}")
         self.no_unknown_keys(t, f, _JOINT_KEYS)
-        walking = name in WALKING_JOINTS
+        walking = split_joint(name)[0] in PITCH_KINDS
 
         model_name = self.string(t, "model", f, f"a servo model ({', '.join(SERVO_MODELS)})")
         if model_name not in SERVO_MODELS:
@@ -438,11 +468,10 @@ class _Reader(Fields):
         max_acceleration_dps2 = self.number(t, "max_acceleration_dps2", f, positive=True)
 
         hold_deg: float | None = None
-        if walking:
-            if "hold_deg" in t:
-                raise self.fail(f"{f}.hold_deg", "only non-walking joints are held at a fixed angle; "
-                                                 "remove it from a walking joint")
-        else:
+        if "hold_deg" in t:
+            if walking:
+                raise self.fail(f"{f}.hold_deg", "only non-walking joints (roll and yaw) may be held: the walk "
+                                                 "moves every hip, knee and ankle pitch joint")
             hold_deg = self.number(t, "hold_deg", f)
             if not min_deg <= hold_deg <= max_deg:
                 raise self.fail(f"{f}.hold_deg", f"{hold_deg} is outside the joint's limits {min_deg}..{max_deg} deg")
