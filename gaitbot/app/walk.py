@@ -47,7 +47,7 @@ def run(args) -> int:
     check_rate_option(config, args.rate)
     args.robot = str(config.path)
     source, walker, trajectory = trajectory_for_robot(args)
-    report = preflight(config, trajectory)
+    report = preflight(config, trajectory, on_boom=args.boom)
     if not report.ok:
         raise UsageError(f"walk refused before anything moved: {report.first_error}")
     frames = trajectory_ticks(config, trajectory)
