@@ -88,7 +88,9 @@ class TrajectorySink:
         angles_rad = ticks_to_angles(self.config, ticks)
         moving = angles_rad[: self.config.calibration.n_walking]
         self.last_root_m = self.root.update(moving[self._pitch_columns])
-        self.writer.write(t_s, moving, (self.last_root_m[0], 0.0, self.last_root_m[1]))
+        # the contact model's root is the hip point; the robot's root may sit above the hips
+        lift = self.config.geometry.hip_below_root_m
+        self.writer.write(t_s, moving, (self.last_root_m[0], 0.0, self.last_root_m[1] + lift))
         self.limits.see(t_s, np.degrees(angles_rad))
         if self.status is not None:
             self.status(self.writer.rows, t_s)
