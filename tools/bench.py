@@ -101,7 +101,7 @@ def bench_gait() -> None:
 def bench_stream(seconds: float) -> None:
     from gaitbot.bus.factory import make_bus
     from gaitbot.stream.clock import MonotonicClock
-    from gaitbot.robot.calibration import angles_to_ticks
+    from gaitbot.robot.calibration import trajectory_ticks
     from gaitbot.robot.config import default_config_path, load_robot_config
     from gaitbot.robot.walk_settings import leg_geometry, walk_settings
     from gaitbot.stream import Streamer
@@ -110,7 +110,7 @@ def bench_stream(seconds: float) -> None:
     geometry, settings = leg_geometry(config), walk_settings(config)
     n_steps = int(seconds / (settings.cycle_s / 2)) + 2
     trajectory = generate_walk(geometry, [0.8 * config.gait.max_step_m] * n_steps, settings)
-    frames = angles_to_ticks(config, trajectory.angles_rad)[: int(seconds * settings.rate_hz)]
+    frames = trajectory_ticks(config, trajectory)[: int(seconds * settings.rate_hz)]
     bus = make_bus(config.bus.backend, config.bus.protocol, "mock", config.bus.baudrate, config.models_by_id,
                    dry_run=True)
     with bus:
@@ -127,7 +127,7 @@ def bench_session(repeats: int = 5) -> None:
     """CPU per frame of the whole 60 Hz path of a dry run: LimitGuard, goal sync write, the read-back of
     one servo, the SDK's packet code and the mock chain, on the virtual clock (no waiting)."""
     from gaitbot.bus.factory import make_robot_bus
-    from gaitbot.robot.calibration import angles_to_ticks, standing_ticks
+    from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
     from gaitbot.robot.config import default_config_path, load_robot_config
     from gaitbot.robot.gains import gain_writes
     from gaitbot.robot.walk_settings import joint_limits_ticks, leg_geometry, walk_settings
@@ -136,7 +136,7 @@ def bench_session(repeats: int = 5) -> None:
 
     config = load_robot_config(default_config_path())
     trajectory = generate_walk(leg_geometry(config), [0.8 * config.gait.max_step_m] * 60, walk_settings(config))
-    frames = angles_to_ticks(config, trajectory.angles_rad)
+    frames = trajectory_ticks(config, trajectory)
     velocity, acceleration = joint_limits_ticks(config)
     per_frame = []
     for _ in range(repeats):

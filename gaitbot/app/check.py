@@ -35,7 +35,7 @@ def _check_trajectory_file(args, path: Path, margin: float) -> int:
     config = load_robot(args.robot, getattr(args, "calibration", None))
     if path.suffix == ".csv" and path.is_file():
         refuse_truncated_csv(path)
-    report = preflight(config, load_fast(path), margin)
+    report = preflight(config, load_fast(path), margin, on_boom=bool(getattr(args, "boom", False)))
     if args.json:
         print(json.dumps({"kind": "trajectory", "file": str(path), **report.to_dict()}, indent=2))
     else:

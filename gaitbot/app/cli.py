@@ -92,6 +92,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--sim", action="store_true",
                    help="walk the simulated robot (MuJoCo, the sim extra) and measure whether it really walks")
     p.add_argument("--free-pitch", action="store_true", help="--sim: let the torso pitch freely (default: held by a boom)")
+    p.add_argument("--boom", action="store_true",
+                   help="the robot walks on a boom: accept a walk that would tip a free-standing robot")
     p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (side view)")
     p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
 
@@ -101,6 +103,8 @@ def build_parser() -> argparse.ArgumentParser:
     _calibration(p)
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.add_argument("--margin-deg", type=float, default=0.0, help="warn within this many degrees of a limit")
+    p.add_argument("--boom", action="store_true",
+                   help="the robot walks on a boom: do not check its balance (ZMP against the support polygon)")
     p.add_argument("--allow-partial", action="store_true",
                    help="recordings: ignore a truncated last line (with a warning), e.g. after a crash")
 

@@ -24,7 +24,8 @@ import numpy as np
 
 from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, cycles_from_trajectory, fit_model,
                                 synthesize_walk, walk_label)
-from gaitbot.gait.trajectory import WALKING_JOINTS, Trajectory
+from gaitbot.gait.joints import PITCH_JOINTS
+from gaitbot.gait.trajectory import Trajectory
 from gaitbot.app.options import UsageError, load_robot
 from gaitbot.check.preflight import preflight
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings
@@ -110,8 +111,8 @@ def print_pose_pca(model: EigenGaitModel, options: FitOptions) -> None:
 
 def _parse_pose(text: str) -> np.ndarray:
     items = text.split(",")
-    if len(items) != len(WALKING_JOINTS):
-        raise UsageError(f"--pose-deg: give {len(WALKING_JOINTS)} angles in degrees ({', '.join(WALKING_JOINTS)}), "
+    if len(items) != len(PITCH_JOINTS):
+        raise UsageError(f"--pose-deg: give {len(PITCH_JOINTS)} angles in degrees ({', '.join(PITCH_JOINTS)}), "
                          f"got {len(items)}")
     try:
         values = np.array([float(v) for v in items])
@@ -124,7 +125,7 @@ def _parse_pose(text: str) -> np.ndarray:
 
 def _check_pose_limits(config, pose_deg: np.ndarray) -> None:
     limits = {j.name: (j.min_deg, j.max_deg) for j in config.joints}
-    for name, value in zip(WALKING_JOINTS, pose_deg):
+    for name, value in zip(PITCH_JOINTS, pose_deg):
         if name in limits:
             lo, hi = limits[name]
             if not (lo <= value <= hi):
@@ -169,10 +170,10 @@ def run_synth(args) -> int:
         if worst > POSE_TOL_DEG:
             j = int(np.argmax(np.abs(miss)))
             hint = f"try --components up to {len(model.eigenvalues)}"
-            if model.pose_dims < len(WALKING_JOINTS):
+            if model.pose_dims < len(PITCH_JOINTS):
                 hint += ", or fit with a smaller --pose-tolerance-deg (more pose axes)"
             raise EigenModelError(f"--pose-deg cannot be reached: the model's {len(alpha)} eigen-motions and "
-                                  f"{model.pose_dims} pose axes miss {WALKING_JOINTS[j]} by {worst:.3g} deg ({hint})")
+                                  f"{model.pose_dims} pose axes miss {PITCH_JOINTS[j]} by {worst:.3g} deg ({hint})")
         alphas = [alpha] * (args.cycles + 1)
         pose_report = (args.pose_time, worst)
     walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,

@@ -24,6 +24,12 @@ def run(args) -> int:
     trajectory = Trajectory.load(args.file)
     source = gait_source(args)
     out = Path(args.output)
+    if source.robot is not None and source.robot.is_3d and getattr(args, "terrain", None) is None:
+        from gaitbot.plot.balance import plot_balance
+
+        plot_balance(trajectory, source.robot, out, title=Path(args.file).name)
+        print(f"wrote {out}")
+        return 0
     terrain = None
     if getattr(args, "terrain", None) is not None:
         terrain = load_course(args.terrain).terrain

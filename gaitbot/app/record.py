@@ -26,6 +26,7 @@ from gaitbot.app.hardware import serial_port
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
 from gaitbot.bus.factory import make_robot_bus
 from gaitbot.gait.footfall import ContactRoot
+from gaitbot.gait.joints import PITCH_JOINTS
 from gaitbot.gait.trajectory import CsvTrajectoryWriter
 from gaitbot.robot.calibration import ticks_to_angles
 from gaitbot.robot.config import RobotConfig
@@ -77,15 +78,20 @@ class TrajectorySink:
         self.writer: CsvTrajectoryWriter | None = None
         self.root: ContactRoot | None = None
         self.last_root_m = np.zeros(2)
+        names = config.walking_joint_names
+        self._pitch_columns = [names.index(n) for n in PITCH_JOINTS]  # the contact model's legs
 
     def open(self) -> None:
-        self.writer = CsvTrajectoryWriter(self.path)
+        self.writer = CsvTrajectoryWriter(self.path, self.config.walking_joint_names)
         self.root = ContactRoot(leg_geometry(self.config))
 
     def add(self, t_s: float, ticks: np.ndarray) -> None:
         angles_rad = ticks_to_angles(self.config, ticks)
-        self.last_root_m = self.root.update(angles_rad[:6])
-        self.writer.write(t_s, angles_rad[:6], self.last_root_m)
+        moving = angles_rad[: self.config.calibration.n_walking]
+        self.last_root_m = self.root.update(moving[self._pitch_columns])
+        # the contact model's root is the hip point; the robot's root may sit above the hips
+        lift = self.config.geometry.hip_below_root_m
+        self.writer.write(t_s, moving, (self.last_root_m[0], 0.0, self.last_root_m[1] + lift))
         self.limits.see(t_s, np.degrees(angles_rad))
         if self.status is not None:
             self.status(self.writer.rows, t_s)

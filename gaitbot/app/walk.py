@@ -14,7 +14,7 @@ from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.log import BusRecorder
 from gaitbot.check.preflight import preflight
-from gaitbot.robot.calibration import angles_to_ticks, standing_ticks
+from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
 from gaitbot.robot.gains import gain_notes, gain_writes
 from gaitbot.robot.walk_settings import joint_limits_ticks
 from gaitbot.sim import import_mujoco
@@ -56,10 +56,13 @@ def run(args) -> int:
     check_rate_option(config, args.rate)
     args.robot = str(config.path)
     source, walker, trajectory = trajectory_for_robot(args)
-    report = preflight(config, trajectory)
+    report = preflight(config, trajectory, on_boom=args.boom)
     if not report.ok:
         raise UsageError(f"walk refused before anything moved: {report.first_error}")
-    frames = angles_to_ticks(config, trajectory.angles_rad)
+    frames = trajectory_ticks(config, trajectory)
+    straight = [name for name in config.walking_joint_names if name not in trajectory.joints]
+    if straight:
+        print(f"note: the trajectory does not move {', '.join(straight)}: held at 0 deg (straight)", file=sys.stderr)
     period = 1.0 / source.settings.rate_hz
     sim = None
     if args.sim:

@@ -3,7 +3,7 @@ plan and a trajectory, for ``plan``, ``generate`` and ``walk``."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -70,9 +70,18 @@ def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:
         return trajectory_file_walk(args)
     if getattr(args, "terrain", None) is not None:
         source, walk = build_terrain_walk(args)
-        return source, walk, walk.trajectory
+        return source, walk, pelvis_root(source, walk.trajectory)
     source, walker = build_walk(args)
-    return source, walker, trajectory_of(walker)
+    return source, walker, pelvis_root(source, trajectory_of(walker))
+
+
+def pelvis_root(source: GaitSource, trajectory: Trajectory) -> Trajectory:
+    """A sagittal walk's root is the hip point; a robot's root (its pelvis frame) may sit above the hips
+    (``[geometry] hip_below_root_m``): lift it there, so the trajectory's root is the robot's."""
+    lift = source.robot.geometry.hip_below_root_m if source.robot is not None else 0.0
+    if lift == 0.0:
+        return trajectory
+    return replace(trajectory, root_m=trajectory.root_m + [0.0, 0.0, lift])
 
 
 def build_terrain_walk(args):

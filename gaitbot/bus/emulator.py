@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 from gaitbot.bus.log import BusRecorder
 from gaitbot.bus.mock import MockPort, rates_match
 from gaitbot.gait.trajectory import Trajectory
-from gaitbot.robot.calibration import angles_to_ticks
+from gaitbot.robot.calibration import trajectory_ticks
 from gaitbot.servos import baud_register_value, dynamixel, feetech, vendor, wire
 from gaitbot.servos.health import encode_load, health_block
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
@@ -851,7 +851,7 @@ def hand_from_ticks(path: str, rate_hz: float | None = None) -> Hand:
 def hand_from_trajectory(robot, path: str, rate_hz: float | None = None) -> Hand:
     """A hand playing a trajectory file (.csv/.npz): its angles through the robot's calibration, held
     joints at their hold angle. Ticks outside a servo's encoder range cannot be reported: refused."""
-    ticks = angles_to_ticks(robot, Trajectory.load(path).angles_rad)
+    ticks = trajectory_ticks(robot, Trajectory.load(path))
     for column, joint in enumerate(robot.joints):
         low, high = int(ticks[:, column].min()), int(ticks[:, column].max())
         if low < joint.model.min_tick or high > joint.model.max_tick:

@@ -33,9 +33,9 @@ from gaitbot.robot.config import JointConfig, RobotConfig
 VELOCITY_METHOD = "forward differences between consecutive samples, attributed to the later sample time"
 ACCELERATION_METHOD = ("second differences with non-uniform spacing, 2*(v[k+1/2]-v[k-1/2])/(t[k+1]-t[k-1]), "
                        "attributed to the middle sample time")
-KIND_ORDER = ("position", "tick_range", "wrap_seam", "velocity", "acceleration")
+KIND_ORDER = ("position", "tick_range", "wrap_seam", "velocity", "acceleration", "balance")
 _UNITS = {"position": "deg", "tick_range": "ticks", "wrap_seam": "ticks", "velocity": "deg/s",
-          "acceleration": "deg/s^2"}
+          "acceleration": "deg/s^2", "balance": "mm"}
 
 
 @dataclass(frozen=True)
@@ -48,7 +48,7 @@ class Violation:
     accelerations are reported as magnitudes.
     """
 
-    kind: str  # "position" | "tick_range" | "wrap_seam" | "velocity" | "acceleration"
+    kind: str  # "position" | "tick_range" | "wrap_seam" | "velocity" | "acceleration" | "balance"
     joint: str
     t_s: float
     value: float
@@ -67,6 +67,14 @@ class Violation:
         """One line for a person, e.g. 'knee_pitch_left: position 112.3 deg at t=2.417 s exceeds max_deg 110.0'."""
         if self.kind == "wrap_seam":
             what = f"tick {self.value:.0f} at t={self.t_s:.3f} s would cross the encoder seam ({self.limit_name})"
+        elif self.kind == "balance" and self.limit_name == "below the floor":
+            what = (f"a sole is {self.value:.1f} mm below the floor at t={self.t_s:.3f} s (is the root the robot's "
+                    f"root? docs/file-formats.md)")
+        elif self.kind == "balance" and self.joint == "support":
+            what = f"no sole touches the ground at t={self.t_s:.3f} s (the trajectory lifts both feet)"
+        elif self.kind == "balance":
+            what = (f"{self.value:.1f} mm outside the support polygon at t={self.t_s:.3f} s: the robot would tip "
+                    f"{self.limit_name}")
         else:
             if self.severity == "warning":
                 verb = "is within the margin of"
@@ -103,6 +111,34 @@ class JointSummary:
 
 
 @dataclass(frozen=True)
+class BalanceSummary:
+    """How close the ZMP came to leaving the support polygon (check/balance.py), or why it was not checked.
+
+    ``closest_margin_mm``: the ZMP's least distance inside the polygon's edge over the whole walk
+    (negative: it left the polygon by that much), at ``closest_t_s``; ``com_travel_m``: the centre of
+    mass's displacement from the first frame to the last (x, y)."""
+
+    checked: bool
+    note: str = ""
+    closest_margin_mm: float = 0.0
+    closest_t_s: float = 0.0
+    frames_outside: int = 0
+    com_travel_m: tuple[float, float] = (0.0, 0.0)
+    frames_without_support: int = 0
+
+    def describe(self) -> str:
+        if not self.checked:
+            return f"not checked ({self.note})"
+        where = "inside" if self.closest_margin_mm >= 0 else "outside"
+        if self.frames_without_support:
+            return f"no sole on the ground in {self.frames_without_support} frames (docs/checking.md)"
+        return (f"ZMP {'inside' if self.frames_outside == 0 else 'outside'} the support polygon"
+                f"{'' if self.frames_outside == 0 else f' in {self.frames_outside} frames'}; closest "
+                f"{abs(self.closest_margin_mm):.1f} mm {where} an edge at t={self.closest_t_s:.3f} s "
+                f"(centre of mass and ZMP of every link's mass, docs/checking.md)")
+
+
+@dataclass(frozen=True)
 class CheckReport:
     """Result of ``check_trajectory``: per-joint summaries and the violations in time order."""
 
@@ -114,6 +150,7 @@ class CheckReport:
     violations: tuple[Violation, ...]
     velocity_method: str = VELOCITY_METHOD
     acceleration_method: str = ACCELERATION_METHOD
+    balance: "BalanceSummary | None" = None
 
     @property
     def errors(self) -> tuple[Violation, ...]:
@@ -149,6 +186,7 @@ class CheckReport:
             "first_error": self.first_error,
             "joints": [asdict(j) for j in self.joints],
             "violations": [{**asdict(v), "unit": v.unit, "message": v.describe()} for v in self.violations],
+            "balance": None if self.balance is None else asdict(self.balance),
         }
 
     def format_text(self, max_per_kind: int = 5) -> str:
@@ -167,6 +205,8 @@ class CheckReport:
             lines.append(f"{j.joint:<20} {used:>16} {limits:>14} {j.closest_to_limit_deg:>11.1f} "
                          f"{vel:>21} {acc:>23}  {j.verdict}")
         lines += ["", f"velocity: {self.velocity_method}", f"acceleration: {self.acceleration_method}"]
+        if self.balance is not None:
+            lines.append(f"balance: {self.balance.describe()}")
         for kind in KIND_ORDER:
             found = [v for v in self.violations if v.kind == kind]
             if not found:
@@ -322,7 +362,8 @@ def _summary(joint, t, angle_deg, t_vel, vel, t_acc, acc, violations, lo, hi, v_
         max_acceleration_dps2=float(a_lim), verdict=verdict)
 
 
-def trajectory_angles_deg(config: RobotConfig, angles_rad) -> np.ndarray:
-    """(N, n_joints) degrees for every joint of the config from (N, 6) walking angles in radians
-    (e.g. ``Trajectory.angles_rad``); held joints at their hold_deg. Feed this to check_trajectory."""
-    return np.degrees(full_angles_rad(config, angles_rad))
+def trajectory_angles_deg(config: RobotConfig, angles_rad, names=None) -> np.ndarray:
+    """(N, n_joints) degrees for every joint of the config from (N, J) angles in radians of the
+    ``names`` joints (default: the moving joints; e.g. ``Trajectory.angles_rad`` and ``.joints``); held
+    joints at their hold_deg. Feed this to check_trajectory."""
+    return np.degrees(full_angles_rad(config, angles_rad, names))

@@ -8,11 +8,12 @@ from .geometry import TABLE1_LEG, LegGeometry
 from .planning import PlannedStep, perturb_steps, steps_for_distance
 from .segments import GaitGenerationError
 from .step_length import StepLengthError, StepLengthInverse
-from .trajectory import WALKING_JOINTS, HeelStrike, Trajectory, TrajectoryFileError
+from .joints import LEG_JOINTS, PITCH_JOINTS
+from .trajectory import HeelStrike, Trajectory, TrajectoryFileError
 from .walker import OnlineWalker, WalkSettings, generate_walk, make_context
 
 __all__ = [
     "TABLE1_LEG", "LegGeometry", "PlannedStep", "perturb_steps", "steps_for_distance", "GaitGenerationError",
-    "StepLengthError", "StepLengthInverse", "WALKING_JOINTS", "HeelStrike", "Trajectory", "TrajectoryFileError",
+    "StepLengthError", "StepLengthInverse", "LEG_JOINTS", "PITCH_JOINTS", "HeelStrike", "Trajectory", "TrajectoryFileError",
     "OnlineWalker", "WalkSettings", "generate_walk", "make_context",
 ]

@@ -27,6 +27,7 @@ import numpy as np
 
 from .contact import ankle_in_body, grounded_ankle, leg_pitch, lowest_sole_y
 from .geometry import LegGeometry, ankle_position, leg_points
+from .joints import PITCH_JOINTS
 from .segments import CLEARANCE_WINDOW
 from .trajectory import HeelStrike, Trajectory
 
@@ -66,7 +67,7 @@ def heel_world_x(geometry: LegGeometry, trajectory: Trajectory) -> np.ndarray:
     """(N, 2) world x of the left and right heel."""
     out = []
     for side in (0, 1):
-        q = trajectory.angles_rad[:, 3 * side:3 * side + 3]
+        q = trajectory.angles_of(PITCH_JOINTS)[:, 3 * side:3 * side + 3]
         _, _, heel, _ = leg_points(geometry, q[:, 0], q[:, 1], q[:, 2])
         out.append(heel[:, 0] + trajectory.root_m[:, 0])
     return np.column_stack(out)
@@ -76,7 +77,7 @@ def detect_heel_strikes(trajectory: Trajectory, geometry: LegGeometry, contact_t
     """Heel strikes from foot contact (for files without them): list of HeelStrike. Feet heights are
     taken relative to the hip, so a file without a root still gives their times."""
     tol = CONTACT_TOL_FRACTION * geometry.leg_length if contact_tol_m is None else contact_tol_m
-    return heel_strikes_from_heights(trajectory.t_s, foot_heights_in_body(geometry, trajectory.angles_rad),
+    return heel_strikes_from_heights(trajectory.t_s, foot_heights_in_body(geometry, trajectory.angles_of(PITCH_JOINTS)),
                                      heel_world_x(geometry, trajectory), tol)
 
 
@@ -101,7 +102,7 @@ class ContactRoot:
         return float(root_x + ankle_x_body - grounded_ankle(self.geometry, 0.0, pitch)[0])
 
     def update(self, angles_rad) -> np.ndarray:
-        """Root (2,) for the next frame's six joint angles (radians, WALKING_JOINTS order)."""
+        """Root (2,) for the next frame's six joint angles (radians, PITCH_JOINTS order)."""
         q = np.asarray(angles_rad, dtype=float)
         heights = foot_heights_in_body(self.geometry, q)
         legs = (q[0:3], q[3:6])
@@ -143,7 +144,7 @@ def swing_clearances(geometry: LegGeometry, trajectory, tol_m: float | None = No
     walker's walks and walks with a root from contact are measured alike. Heel strikes are the file's,
     else detected (``detect_heel_strikes``); strikes with no airborne frames before them are skipped."""
     tol = CONTACT_TOL_FRACTION * geometry.leg_length if tol_m is None else tol_m
-    heights = foot_heights_in_body(geometry, trajectory.angles_rad) + trajectory.root_m[:, 1:2]
+    heights = foot_heights_in_body(geometry, trajectory.angles_of(PITCH_JOINTS)) + trajectory.root_m[:, 2:3]
     out = []
     for strike in trajectory.heel_strikes or detect_heel_strikes(trajectory, geometry):
         side = 0 if strike.leg == "left" else 1

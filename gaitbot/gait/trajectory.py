@@ -1,13 +1,16 @@
-"""The Trajectory type: joint angles and root position over time, and its CSV/NPZ files.
+"""The Trajectory type: joint angles and the root in 3D over time, and its CSV/NPZ files.
 
-Every later room reads trajectories, so the file contract is fixed here:
-CSV with a header row ``t_s, <joint>_deg x 6, root_x_m, root_y_m``; angles are
-flexion-positive degrees in files and radians in memory.
+Every later room reads trajectories, so the file contract is fixed here (docs/file-formats.md):
+format 2 is a CSV whose first line is ``# gaitbot trajectory 2``, then a header
+``t_s, <joint>_deg for each moving joint, root_x_m, root_y_m, root_z_m[, torso_roll_deg,
+torso_pitch_deg, torso_yaw_deg]``; format 1 (the six pitch joints, ``root_y_m`` the height) still
+loads. Angles are degrees in files and radians in memory.
 """
 
 from __future__ import annotations
 
 import csv
+import difflib
 import io
 import os
 from dataclasses import dataclass, field
@@ -16,16 +19,14 @@ from pathlib import Path
 import numpy as np
 
 from gaitbot.errors import UserError
+from gaitbot.gait.joints import LEG_JOINTS, PITCH_JOINTS, canonical, is_leg_joint
 
-WALKING_JOINTS = (
-    "hip_pitch_left",
-    "knee_pitch_left",
-    "ankle_pitch_left",
-    "hip_pitch_right",
-    "knee_pitch_right",
-    "ankle_pitch_right",
-)
-CSV_COLUMNS = ("t_s",) + tuple(f"{name}_deg" for name in WALKING_JOINTS) + ("root_x_m", "root_y_m")
+FORMAT_VERSION = 2
+VERSION_LINE = f"# gaitbot trajectory {FORMAT_VERSION}"
+ROOT_COLUMNS = ("root_x_m", "root_y_m", "root_z_m")
+TORSO_COLUMNS = ("torso_roll_deg", "torso_pitch_deg", "torso_yaw_deg")
+V1_COLUMNS = ("t_s",) + tuple(f"{name}_deg" for name in PITCH_JOINTS) + ("root_x_m", "root_y_m")
+"""Format 1 (before 3D): the six pitch joints and the root in the sagittal plane, root_y_m its height."""
 
 
 class TrajectoryFileError(UserError, ValueError):
@@ -34,11 +35,13 @@ class TrajectoryFileError(UserError, ValueError):
 
 @dataclass(frozen=True)
 class HeelStrike:
-    """One heel strike: when, which leg, and where the heel touched the ground (world x, metres)."""
+    """One heel strike: when, which leg, and where the heel touched the ground (world x, metres), with
+    the sole centre's lateral position y_m (metres, left positive) where the walk is 3D (None: planar)."""
 
     t_s: float
     leg: str  # "left" or "right"
     x_m: float
+    y_m: float | None = None
 
 
 @dataclass(frozen=True)
@@ -46,22 +49,39 @@ class Trajectory:
     """Sampled walking motion.
 
     t_s: (N,) sample times in seconds, increasing.
-    angles_rad: (N, 6) joint angles in radians, columns in WALKING_JOINTS order, flexion positive.
-    root_m: (N, 2) the hip point in the world (x forward, y up; ground at y = 0), metres.
+    angles_rad: (N, J) joint angles in radians, one column per name in ``joints`` (canonical order,
+        gaitbot.gait.joints), signs as documented there.
+    root_m: (N, 3) the root (pelvis) in the world, ROS REP-103 axes: x forward, y left, z up; ground
+        at z = 0. A sagittal walk has y = 0 and its root at the hip point.
     heel_strikes: the planned heel-strike events, in time order.
+    joints: the joint names of the columns of angles_rad (default: the planar walker's six).
+    torso_rpy_rad: (N, 3) torso roll, pitch, yaw (radians) where the gait moves them; None: upright.
     """
 
     t_s: np.ndarray
     angles_rad: np.ndarray
     root_m: np.ndarray
     heel_strikes: tuple[HeelStrike, ...] = field(default_factory=tuple)
+    joints: tuple[str, ...] = PITCH_JOINTS
+    torso_rpy_rad: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = len(self.t_s)
-        if self.angles_rad.shape != (n, len(WALKING_JOINTS)):
-            raise ValueError(f"angles_rad must have shape ({n}, {len(WALKING_JOINTS)}), got {self.angles_rad.shape}")
-        if self.root_m.shape != (n, 2):
-            raise ValueError(f"root_m must have shape ({n}, 2), got {self.root_m.shape}")
+        if tuple(self.joints) != canonical(self.joints) or len(set(self.joints)) != len(self.joints):
+            raise ValueError(f"joints must be distinct leg joints in canonical order, got {self.joints}")
+        if self.angles_rad.shape != (n, len(self.joints)):
+            raise ValueError(f"angles_rad must have shape ({n}, {len(self.joints)}), got {self.angles_rad.shape}")
+        if self.root_m.shape != (n, 3):
+            raise ValueError(f"root_m must have shape ({n}, 3), got {self.root_m.shape}")
+        if self.torso_rpy_rad is not None and self.torso_rpy_rad.shape != (n, 3):
+            raise ValueError(f"torso_rpy_rad must have shape ({n}, 3), got {self.torso_rpy_rad.shape}")
+
+    @classmethod
+    def sagittal(cls, t_s, angles_rad, root_xz_m, heel_strikes=()) -> "Trajectory":
+        """A planar walk of the six pitch joints, its root given in the sagittal plane as (x, height)."""
+        root_xz_m = np.asarray(root_xz_m, dtype=float)
+        return cls(np.asarray(t_s, dtype=float), np.asarray(angles_rad, dtype=float), sagittal_to_world(root_xz_m),
+                   tuple(heel_strikes))
 
     def __len__(self) -> int:
         return len(self.t_s)
@@ -70,28 +90,53 @@ class Trajectory:
     def angles_deg(self) -> np.ndarray:
         return np.degrees(self.angles_rad)
 
+    @property
+    def root_xz_m(self) -> np.ndarray:
+        """The root in the sagittal plane, (N, 2): forward and height (what the planar gait code uses)."""
+        return self.root_m[:, [0, 2]]
+
     def joint_deg(self, name: str) -> np.ndarray:
-        """Angle of one walking joint over time, in degrees."""
-        return np.degrees(self.angles_rad[:, WALKING_JOINTS.index(name)])
+        """Angle of one joint over time, in degrees."""
+        return np.degrees(self.angles_rad[:, self.joints.index(name)])
+
+    def angles_of(self, names) -> np.ndarray:
+        """(N, len(names)) angles in radians of the named joints; KeyError names one the file lacks."""
+        missing = [n for n in names if n not in self.joints]
+        if missing:
+            raise KeyError(f"the trajectory has no {missing[0]} (it moves {', '.join(self.joints)})")
+        return self.angles_rad[:, [self.joints.index(n) for n in names]]
+
+    def columns(self) -> tuple[str, ...]:
+        """The CSV header of this trajectory (format 2)."""
+        torso = TORSO_COLUMNS if self.torso_rpy_rad is not None else ()
+        return ("t_s",) + tuple(f"{name}_deg" for name in self.joints) + ROOT_COLUMNS + torso
+
+    def table(self) -> np.ndarray:
+        """One row per frame in the order of ``columns()``: seconds, degrees, metres."""
+        parts = [self.t_s[:, None], self.angles_deg, self.root_m]
+        if self.torso_rpy_rad is not None:
+            parts.append(np.degrees(self.torso_rpy_rad))
+        return np.column_stack(parts)
 
     def save(self, path: str | Path) -> None:
-        """Write to ``.csv`` or ``.npz`` (chosen by the suffix)."""
+        """Write to ``.csv`` or ``.npz`` (chosen by the suffix), format 2."""
         path = Path(path)
         if path.suffix == ".npz":
-            strikes = np.array([(h.t_s, 0 if h.leg == "left" else 1, h.x_m) for h in self.heel_strikes]).reshape(-1, 3)
-            np.savez(path, t_s=self.t_s, angles_deg=self.angles_deg, root_m=self.root_m,
-                     heel_strikes=strikes, joints=np.array(WALKING_JOINTS))
+            strikes = np.array([(h.t_s, 0 if h.leg == "left" else 1, h.x_m, np.nan if h.y_m is None else h.y_m)
+                                for h in self.heel_strikes], dtype=float).reshape(-1, 4)
+            extra = {} if self.torso_rpy_rad is None else {"torso_rpy_deg": np.degrees(self.torso_rpy_rad)}
+            np.savez(path, format_version=np.array(FORMAT_VERSION), t_s=self.t_s, angles_deg=self.angles_deg,
+                     root_m=self.root_m, heel_strikes=strikes, joints=np.array(self.joints), **extra)
         elif path.suffix == ".csv":
-            table = np.column_stack([self.t_s, self.angles_deg, self.root_m])
             with open(path, "w", newline="") as f:
-                f.write(",".join(CSV_COLUMNS) + "\n")
-                np.savetxt(f, table, delimiter=",", fmt="%.9g")
+                f.write(VERSION_LINE + "\n" + ",".join(self.columns()) + "\n")
+                np.savetxt(f, self.table(), delimiter=",", fmt="%.9g")
         else:
             raise TrajectoryFileError(f"{path}: unknown trajectory format {path.suffix!r} (allowed: .csv, .npz)")
 
     @classmethod
     def load(cls, path: str | Path) -> "Trajectory":
-        """Read a ``.csv`` or ``.npz`` trajectory; raise TrajectoryFileError with a one-line reason."""
+        """Read a ``.csv`` or ``.npz`` trajectory (format 1 or 2); raise TrajectoryFileError with a one-line reason."""
         path = Path(path)
         if not path.is_file():
             raise TrajectoryFileError(f"{path}: no such file")
@@ -102,23 +147,31 @@ class Trajectory:
         raise TrajectoryFileError(f"{path}: unknown trajectory format {path.suffix!r} (allowed: .csv, .npz)")
 
 
+def sagittal_to_world(root_xz_m: np.ndarray) -> np.ndarray:
+    """(N, 2) sagittal-plane points (forward, up) -> (N, 3) world points (x, y = 0, z)."""
+    return np.column_stack([root_xz_m[:, 0], np.zeros(len(root_xz_m)), root_xz_m[:, 1]])
+
+
 class CsvTrajectoryWriter:
     """A trajectory CSV written row by row (``gaitbot record``), readable at every moment.
 
-    The header goes out at once; every row is handed to the operating system as it is written
-    (one ``write`` of the whole line, then ``flush``), so a process that stops for any reason,
-    even SIGKILL, leaves a file holding every complete row; ``sync()`` (fsync) also makes it
-    survive a power cut. Same columns and number format as ``Trajectory.save``.
+    The version line and header go out at once; every row is handed to the operating system as it is
+    written (one ``write`` of the whole line, then ``flush``), so a process that stops for any reason,
+    even SIGKILL, leaves a file holding every complete row; ``sync()`` (fsync) also makes it survive a
+    power cut. Same columns and number format as ``Trajectory.save``.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, joints: tuple[str, ...] = PITCH_JOINTS) -> None:
         self.path = Path(path)
+        self.joints = canonical(joints)
         self.rows = 0
         self._file = open(self.path, "w", newline="", encoding="ascii")
-        self._file.write(",".join(CSV_COLUMNS) + "\n")
+        header = ("t_s",) + tuple(f"{name}_deg" for name in self.joints) + ROOT_COLUMNS
+        self._file.write(VERSION_LINE + "\n" + ",".join(header) + "\n")
         self._file.flush()
 
     def write(self, t_s: float, angles_rad, root_m) -> None:
+        """One frame: angles (radians) of ``joints``, the root (x, y, z metres)."""
         values = [float(t_s), *np.degrees(np.asarray(angles_rad, dtype=float)), *np.asarray(root_m, dtype=float)]
         self._file.write(",".join(f"{v + 0.0:.9g}" for v in values) + "\n")  # + 0.0: no "-0" in the file
         self._file.flush()
@@ -134,16 +187,74 @@ class CsvTrajectoryWriter:
             self._file.close()
 
 
-def _from_table(path: Path, t: np.ndarray, angles_deg: np.ndarray, root: np.ndarray, strikes=()) -> Trajectory:
+def _from_table(path: Path, t: np.ndarray, angles_deg: np.ndarray, root: np.ndarray, strikes=(),
+                joints: tuple[str, ...] = PITCH_JOINTS, torso_deg: np.ndarray | None = None) -> Trajectory:
     if len(t) < 2:
         raise TrajectoryFileError(f"{path}: needs at least 2 samples, found {len(t)}")
-    for name, values in (("t_s", t), ("joint angles", angles_deg), ("root", root)):
-        if not np.all(np.isfinite(values)):
+    named = (("t_s", t), ("joint angles", angles_deg), ("root", root), ("torso attitude", torso_deg))
+    for name, values in named:
+        if values is not None and not np.all(np.isfinite(values)):
             raise TrajectoryFileError(f"{path}: column {name} holds a value that is not a finite number")
     if np.any(np.diff(t) <= 0):
         i = int(np.argmax(np.diff(t) <= 0)) + 1
         raise TrajectoryFileError(f"{path}: t_s must increase, but row {i + 1} has t_s={t[i]!r} after {t[i - 1]!r}")
-    return Trajectory(t.astype(float), np.radians(angles_deg.astype(float)), root.astype(float), tuple(strikes))
+    order = [joints.index(name) for name in canonical(joints)]
+    torso = None if torso_deg is None else np.radians(torso_deg.astype(float))
+    return Trajectory(t.astype(float), np.radians(angles_deg[:, order].astype(float)), root.astype(float),
+                      tuple(strikes), canonical(joints), torso)
+
+
+def _csv_layout(path: Path, version: int | None, header: list[str]) -> tuple[tuple[str, ...], bool, bool]:
+    """From a CSV's version line and header: (joint names in file order, format-1 root, has torso)."""
+    if version is None and "root_z_m" not in header:  # format 1: today's six joints, root_y_m the height
+        missing = [c for c in V1_COLUMNS if c not in header]
+        if missing:
+            raise TrajectoryFileError(f"{path}: missing column {missing[0]!r} (format 1 holds {','.join(V1_COLUMNS)}; "
+                                      f"format 2 starts with the line {VERSION_LINE!r})")
+        return PITCH_JOINTS, True, False
+    if version not in (None, FORMAT_VERSION):
+        raise TrajectoryFileError(f"{path}: trajectory format {version} is not one this gaitbot reads (1 or 2)")
+    for column in ("t_s",) + ROOT_COLUMNS:
+        if column not in header:
+            raise TrajectoryFileError(f"{path}: missing column {column!r} (format 2 holds t_s, <joint>_deg columns, "
+                                      f"{', '.join(ROOT_COLUMNS)})")
+    torso = [c for c in TORSO_COLUMNS if c in header]
+    if torso and len(torso) != 3:
+        missing = next(c for c in TORSO_COLUMNS if c not in header)
+        raise TrajectoryFileError(f"{path}: missing column {missing!r} (the torso attitude needs all of "
+                                  f"{', '.join(TORSO_COLUMNS)})")
+    joints = []
+    for column in header:
+        if column.endswith("_deg") and column not in TORSO_COLUMNS:
+            name = column[: -len("_deg")]
+            if not is_leg_joint(name):
+                close = difflib.get_close_matches(name, LEG_JOINTS, n=1)
+                hint = f"did you mean {close[0]}_deg? " if close else ""
+                raise TrajectoryFileError(f"{path}: column {column!r} is not a joint gaitbot knows ({hint}joints: "
+                                          f"{', '.join(LEG_JOINTS)})")
+            if name in joints:
+                raise TrajectoryFileError(f"{path}: column {column!r} appears twice")
+            joints.append(name)
+    _require_pitch_joints(path, joints, lambda name: f"column '{name}_deg'")
+    return tuple(joints), False, bool(torso)
+
+
+def _require_pitch_joints(path: Path, joints, what) -> None:
+    """Every walk moves both legs' hip, knee and ankle pitch: a file without one of them is not a walk."""
+    for name in PITCH_JOINTS:
+        if name not in joints:
+            raise TrajectoryFileError(f"{path}: missing {what(name)} (a trajectory holds at least the pitch "
+                                      f"joints {', '.join(PITCH_JOINTS)})")
+
+
+def _read_version_line(path: Path, first: str) -> int | None:
+    """The format version of a ``# gaitbot trajectory N`` line; None when the first line is the header."""
+    if not first.startswith("#"):
+        return None
+    words = first.lstrip("#").split()
+    if len(words) == 3 and words[:2] == ["gaitbot", "trajectory"] and words[2].isdigit() and len(words[2]) < 4:
+        return int(words[2])
+    raise TrajectoryFileError(f"{path}: the first line must be {VERSION_LINE!r} or the header, got {first[:60]!r}")
 
 
 def _load_csv(path: Path) -> Trajectory:
@@ -152,15 +263,20 @@ def _load_csv(path: Path) -> Trajectory:
     except (OSError, UnicodeDecodeError) as exc:
         raise TrajectoryFileError(f"{path}: cannot read ({exc})") from None
     rows = list(csv.reader(io.StringIO(text)))
+    if rows and rows[0] and rows[0][0].startswith("#"):
+        version = _read_version_line(path, ",".join(rows[0]).strip())
+        rows = rows[1:]
+    else:
+        version = None
     if not rows:
-        raise TrajectoryFileError(f"{path}: empty file (expected a header row {','.join(CSV_COLUMNS)})")
+        raise TrajectoryFileError(f"{path}: empty file (expected a header row, e.g. {','.join(V1_COLUMNS)})")
     header = [h.strip() for h in rows[0]]
-    missing = [c for c in CSV_COLUMNS if c not in header]
-    if missing:
-        raise TrajectoryFileError(f"{path}: missing column {missing[0]!r} (header must hold {','.join(CSV_COLUMNS)})")
-    index = [header.index(c) for c in CSV_COLUMNS]
+    joints, v1_root, torso = _csv_layout(path, version, header)
+    root_columns = ("root_x_m", "root_y_m") if v1_root else ROOT_COLUMNS
+    wanted = ("t_s",) + tuple(f"{n}_deg" for n in joints) + root_columns + (TORSO_COLUMNS if torso else ())
+    index = [header.index(c) for c in wanted]
     data = []
-    for line_no, row in enumerate(rows[1:], start=2):
+    for line_no, row in enumerate(rows[1:], start=2 + (version is not None)):
         if not row or all(not cell.strip() for cell in row):
             continue
         if len(row) != len(header):
@@ -169,8 +285,14 @@ def _load_csv(path: Path) -> Trajectory:
             data.append([float(row[i]) for i in index])
         except ValueError:
             raise TrajectoryFileError(f"{path}: line {line_no} holds a value that is not a number") from None
-    table = np.array(data, dtype=float).reshape(-1, len(CSV_COLUMNS))
-    return _from_table(path, table[:, 0], table[:, 1:7], table[:, 7:9])
+    table = np.array(data, dtype=float).reshape(-1, len(wanted))
+    j = len(joints)
+    if v1_root:
+        root = sagittal_to_world(table[:, 1 + j:3 + j])
+    else:
+        root = table[:, 1 + j:4 + j]
+    torso_deg = table[:, 4 + j:7 + j] if torso else None
+    return _from_table(path, table[:, 0], table[:, 1:1 + j], root, joints=joints, torso_deg=torso_deg)
 
 
 def _load_npz(path: Path) -> Trajectory:
@@ -180,15 +302,31 @@ def _load_npz(path: Path) -> Trajectory:
             if missing:
                 raise TrajectoryFileError(f"{path}: missing array {missing[0]!r} (needs t_s, angles_deg, root_m)")
             t, ang, root = z["t_s"], z["angles_deg"], z["root_m"]
-            raw = z["heel_strikes"] if "heel_strikes" in z.files else np.zeros((0, 3))
+            raw = z["heel_strikes"] if "heel_strikes" in z.files else np.zeros((0, 4))
+            names = tuple(str(n) for n in z["joints"].reshape(-1)) if "joints" in z.files else PITCH_JOINTS
+            version = int(z["format_version"]) if "format_version" in z.files else 1
+            torso = z["torso_rpy_deg"] if "torso_rpy_deg" in z.files else None
     except TrajectoryFileError:
         raise
     except Exception as exc:  # zipfile/ValueError/EOFError on a truncated or foreign file
         raise TrajectoryFileError(f"{path}: not a readable .npz trajectory ({type(exc).__name__}: {exc})") from None
-    if ang.ndim != 2 or ang.shape[1] != 6 or ang.shape[0] != len(t) or root.shape != (len(t), 2):
-        raise TrajectoryFileError(f"{path}: arrays have inconsistent shapes t_s{t.shape} angles_deg{ang.shape} root_m{root.shape}")
-    strikes = [HeelStrike(float(a), "left" if int(b) == 0 else "right", float(c)) for a, b, c in raw.reshape(-1, 3)]
-    return _from_table(path, t, ang, root, strikes)
+    if version not in (1, FORMAT_VERSION):
+        raise TrajectoryFileError(f"{path}: trajectory format {version} is not one this gaitbot reads (1 or 2)")
+    unknown = [n for n in names if not is_leg_joint(n)]
+    if unknown or len(set(names)) != len(names) or (version == 1 and names != PITCH_JOINTS):
+        raise TrajectoryFileError(f"{path}: array joints {list(names)[:12]} must name distinct leg joints")
+    _require_pitch_joints(path, names, lambda name: f"joint {name}")
+    width = 2 if version == 1 else 3
+    if (ang.ndim != 2 or ang.shape[1] != len(names) or ang.shape[0] != len(t) or root.shape != (len(t), width)
+            or (torso is not None and torso.shape != (len(t), 3))):
+        raise TrajectoryFileError(f"{path}: arrays have inconsistent shapes t_s{t.shape} angles_deg{ang.shape} "
+                                  f"root_m{root.shape}")
+    if version == 1:
+        root = sagittal_to_world(root)
+    rows = raw.reshape(-1, raw.shape[-1] if raw.ndim == 2 else 3)
+    strikes = [HeelStrike(float(r[0]), "left" if int(r[1]) == 0 else "right", float(r[2]),
+                          None if len(r) < 4 or np.isnan(r[3]) else float(r[3])) for r in rows]
+    return _from_table(path, t, ang, root, strikes, names, torso)
 
 
 def load_fast(path: str | Path) -> Trajectory:
@@ -200,12 +338,18 @@ def load_fast(path: str | Path) -> Trajectory:
     if path.suffix == ".csv" and path.is_file():
         try:
             with open(path, encoding="utf-8") as f:
-                header = f.readline().strip()
-                if header == ",".join(CSV_COLUMNS):
-                    table = np.loadtxt(f, delimiter=",", ndmin=2, dtype=float)
-                    if (table.shape[1] == len(CSV_COLUMNS) and len(table) >= 2 and np.all(np.isfinite(table))
-                            and np.all(np.diff(table[:, 0]) > 0)):
-                        return Trajectory(table[:, 0].copy(), np.radians(table[:, 1:7]), table[:, 7:9].copy())
+                if f.readline().strip() == VERSION_LINE:
+                    header = f.readline().strip().split(",")
+                    joints = tuple(c[:-4] for c in header[1:] if c.endswith("_deg") and c not in TORSO_COLUMNS)
+                    if (all(is_leg_joint(n) for n in joints) and joints == canonical(joints)
+                            and set(PITCH_JOINTS) <= set(joints)
+                            and header == list(("t_s",) + tuple(f"{n}_deg" for n in joints) + ROOT_COLUMNS)):
+                        table = np.loadtxt(f, delimiter=",", ndmin=2, dtype=float)
+                        j = len(joints)
+                        if (table.shape[1] == len(header) and len(table) >= 2 and np.all(np.isfinite(table))
+                                and np.all(np.diff(table[:, 0]) > 0)):
+                            return Trajectory(table[:, 0].copy(), np.radians(table[:, 1:1 + j]),
+                                              table[:, 1 + j:4 + j].copy(), joints=joints)
         except (OSError, UnicodeDecodeError, ValueError):
             pass
     return Trajectory.load(path)

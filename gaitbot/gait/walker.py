@@ -181,7 +181,7 @@ def trajectory_of(walker: OnlineWalker) -> Trajectory:
     angles = np.array([f[0] for f in frames])
     root = np.array([f[1] for f in frames])
     t = (walker._frame_index + np.arange(len(frames))) / walker.ctx.rate_hz
-    return Trajectory(t, angles, root, tuple(walker.heel_strikes))
+    return Trajectory.sagittal(t, angles, root, walker.heel_strikes)
 
 
 def generate_walk(geometry: LegGeometry, step_lengths, settings: WalkSettings = WalkSettings()) -> Trajectory:

@@ -13,15 +13,16 @@ import numpy as np
 
 from gaitbot.gait.footfall import CONTACT_TOL_FRACTION, heel_strikes_from_heights
 from gaitbot.gait.geometry import LegGeometry, leg_points
-from gaitbot.gait.trajectory import WALKING_JOINTS, HeelStrike, Trajectory
+from gaitbot.gait.joints import PITCH_JOINTS
+from gaitbot.gait.trajectory import HeelStrike, Trajectory
 
 _COLOURS = {"left": "tab:blue", "right": "tab:red"}
 
 
 def _world_points(geometry: LegGeometry, trajectory: Trajectory, side: int):
-    q = trajectory.angles_rad[:, 3 * side:3 * side + 3]
+    q = trajectory.angles_of(PITCH_JOINTS)[:, 3 * side:3 * side + 3]
     knee, ankle, heel, toe = leg_points(geometry, q[:, 0], q[:, 1], q[:, 2])
-    root = trajectory.root_m
+    root = trajectory.root_xz_m
     return root, knee + root, ankle + root, heel + root, toe + root
 
 
@@ -61,9 +62,11 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
     grid = fig.add_gridspec(3, 1, height_ratios=[1.2, 0.8, 1.0])
     ax_angles, ax_feet, ax_stick = (fig.add_subplot(grid[i]) for i in range(3))
 
-    for i, name in enumerate(WALKING_JOINTS):
+    for i, name in enumerate(trajectory.joints):
         side = "left" if name.endswith("left") else "right"
         style = {"hip": "-", "knee": "--", "ankle": ":"}[name.split("_")[0]]
+        if "_pitch" not in name:
+            style = "-."  # roll and yaw
         ax_angles.plot(t, np.degrees(trajectory.angles_rad[:, i]), style, color=_COLOURS[side], lw=1.2,
                        label=name.replace("_pitch", ""))
     for strike in heel_strikes:
@@ -93,7 +96,7 @@ def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, cl
             xs = [root[k, 0], knee[k, 0], ankle[k, 0], heel[k, 0], toe[k, 0], ankle[k, 0]]
             ys = [root[k, 1], knee[k, 1], ankle[k, 1], heel[k, 1], toe[k, 1], ankle[k, 1]]
             ax_stick.plot(xs, ys, color=_COLOURS[name], lw=1.0, alpha=0.7)
-    ax_stick.plot(trajectory.root_m[:, 0], trajectory.root_m[:, 1], color="k", lw=0.8, label="hip path")
+    ax_stick.plot(trajectory.root_m[:, 0], trajectory.root_m[:, 2], color="k", lw=0.8, label="hip path")
     ground = (lambda x: float(terrain.height_at(x))) if terrain is not None else (lambda x: 0.0)  # noqa: E731
     for strike in heel_strikes:
         ax_stick.plot([strike.x_m], [ground(strike.x_m)], marker="^", color=_COLOURS[strike.leg], ms=8)

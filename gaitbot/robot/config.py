@@ -25,8 +25,13 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from gaitbot.fields import FieldError, Fields, kind, read_toml
-from gaitbot.gait.trajectory import WALKING_JOINTS
+from gaitbot.gait.balance.settings import LIMITS as BALANCE_LIMITS
+from gaitbot.gait.balance.settings import BalanceSettings
+from gaitbot.gait.body import LEG_LINKS, BodyGeometry, BodyModel, LinkInertial, inertia_matrix
+from gaitbot.gait.joints import LEG_JOINTS, PITCH_JOINTS, PITCH_KINDS, canonical, is_leg_joint, mirror, split_joint
 from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
 from gaitbot.robot.gains import GainError, gain_for_error
 from gaitbot.robot.health import HealthSettings, read_health
@@ -52,7 +57,9 @@ class ConfigError(FieldError):
 class Geometry:
     """Leg dimensions in metres: hip-knee, knee-ankle, foot length (heel to toe), distance between
     the hip joints, ankle axis above the sole, and heel behind the ankle axis (0: the heel is the
-    ankle projected on the sole, seed 000's foot)."""
+    ankle projected on the sole, seed 000's foot). For 3D (gaitbot.gait.body): the sole's width
+    (None: not given; 3D robots must), its centre outward of the ankle, and the hip point below the
+    root (the pelvis frame's origin)."""
 
     thigh_m: float
     shank_m: float
@@ -60,6 +67,15 @@ class Geometry:
     hip_width_m: float
     ankle_height_m: float = 0.0
     heel_back_m: float = 0.0
+    foot_width_m: float | None = None
+    sole_outward_m: float = 0.0
+    hip_below_root_m: float = 0.0
+
+    def body_geometry(self) -> BodyGeometry:
+        """The 3D leg geometry; a sole of unknown width is taken as a quarter of its length either side."""
+        width = self.foot_width_m if self.foot_width_m is not None else self.foot_m / 2
+        return BodyGeometry(self.thigh_m, self.shank_m, self.foot_m, width, self.hip_width_m, self.ankle_height_m,
+                            self.heel_back_m, self.sole_outward_m, self.hip_below_root_m)
 
 
 @dataclass(frozen=True)
@@ -148,7 +164,8 @@ class ServoSettings:
 
 @dataclass(frozen=True)
 class RobotConfig:
-    """A whole robot: joints are the walking joints in WALKING_JOINTS order, then the held joints."""
+    """A whole robot: joints are the moving joints in canonical order (gaitbot.gait.joints), then the
+    held ones (``hold_deg``) in canonical order; the bus addresses them in this order."""
 
     path: Path
     name: str
@@ -161,14 +178,39 @@ class RobotConfig:
     terrain: TerrainReach | None = None
     calibration_file: Path | None = None  # the calibration file applied on top (gaitbot.robot.calibration_file)
     health: HealthSettings = HealthSettings()  # [health] overrides (gaitbot.robot.health)
+    balance: BalanceSettings = BalanceSettings()
+    links: tuple[tuple[str, LinkInertial], ...] | None = None
+    boom: bool = False
+
+    @cached_property
+    def body(self) -> BodyModel:
+        """Every link's mass: the ``[links.*]`` table, else the four ``[mass]`` segments (planar robots)."""
+        geometry = self.geometry.body_geometry()
+        if self.links is not None:
+            links = dict(self.links)
+            return BodyModel(geometry, links["torso"], {name: links[name] for name in LEG_LINKS})
+        m = self.mass
+        return BodyModel.from_segment_masses(geometry, m.torso_kg, m.thigh_kg, m.shank_kg, m.foot_kg,
+                                             TORSO_HEIGHT_LEGS * geometry.leg_length_m)
 
     @property
     def walking_joints(self) -> tuple[JointConfig, ...]:
-        return self.joints[: len(WALKING_JOINTS)]
+        """The joints the gait moves (no ``hold_deg``), in canonical order."""
+        return tuple(j for j in self.joints if j.hold_deg is None)
 
     @property
     def held_joints(self) -> tuple[JointConfig, ...]:
-        return self.joints[len(WALKING_JOINTS):]
+        return tuple(j for j in self.joints if j.hold_deg is not None)
+
+    @property
+    def walking_joint_names(self) -> tuple[str, ...]:
+        return tuple(j.name for j in self.walking_joints)
+
+    @property
+    def is_3d(self) -> bool:
+        """True when the legs move in roll as well as pitch (hip and ankle roll joints that walk):
+        such a robot can shift its weight sideways over one foot; a pitch-only one needs a boom."""
+        return "hip_roll_left" in self.walking_joint_names and "ankle_roll_left" in self.walking_joint_names
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -182,7 +224,7 @@ class RobotConfig:
     @cached_property
     def calibration(self) -> Calibration:
         """Angles <-> ticks for every joint, built once per config."""
-        return Calibration.of(self.joints, len(WALKING_JOINTS))
+        return Calibration.of(self.joints)
 
     @property
     def models_by_id(self) -> dict[int, ServoModel]:
@@ -271,12 +313,20 @@ def load_robot_config(path: str | Path, *, extra_checks: Iterable[ConfigCheck] =
     return config
 
 
-_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain", "health")
-_MASS_KEYS = ("torso_kg", "thigh_kg", "shank_kg", "foot_kg")
+TORSO_HEIGHT_LEGS = 0.6
+"""A planar robot's torso (``[mass] torso_kg``) is a box this many leg lengths tall standing on the hips."""
+MASS_TOLERANCE_KG = 1e-4
+"""``[mass] total_kg`` must equal the links' sum within this (0.1 g: the files hold 6 digits)."""
+
+_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain", "health", "balance", "links")
+_MASS_KEYS = ("torso_kg", "thigh_kg", "shank_kg", "foot_kg", "total_kg")
+_LINK_NAMES = ("torso",) + LEG_LINKS
+_LINK_KEYS = ("mass_kg", "com_m", "inertia_kg_m2")
 _SERVO_KEYS = ("stall_torque_nm", "no_load_speed_rpm", "full_torque_error_deg")
 _TERRAIN_KEYS = ("max_rise_m", "max_drop_m", "max_gap_m")
-_ROBOT_KEYS = ("name",)
-_GEOMETRY_KEYS = ("thigh_m", "shank_m", "foot_m", "hip_width_m", "ankle_height_m", "heel_back_m")
+_ROBOT_KEYS = ("name", "boom")
+_GEOMETRY_KEYS = ("thigh_m", "shank_m", "foot_m", "hip_width_m", "ankle_height_m", "heel_back_m", "foot_width_m",
+                  "sole_outward_m", "hip_below_root_m")
 _GAIT_KEYS = ("cycle_s", "max_step_m", "clearance_m", "rate_hz")
 _BUS_KEYS = ("backend", "protocol", "port", "baudrate", "torque_off_on_exit")
 _JOINT_KEYS = ("id", "model", "zero_tick", "direction", "min_deg", "max_deg", "max_velocity_dps",
@@ -299,7 +349,9 @@ class _Reader(Fields):
         gait = self.gait(self.table(data, "gait", "gait", _GAIT_KEYS))
         bus = self.bus(self.table(data, "bus", "bus", _BUS_KEYS))
         joints = self.joints(data, bus)
-        mass = self.mass(self.optional_table(data, "mass", "mass", _MASS_KEYS))
+        boom = self.boolean(robot, "boom", "robot", default=False)
+        links = self.links(data) if "links" in data else None
+        mass = self.mass(self.optional_table(data, "mass", "mass", _MASS_KEYS), links)
         servo = self.servo(self.optional_table(data, "servo", "servo", _SERVO_KEYS))
         self.gains_settable(joints, servo)
         terrain = None
@@ -307,13 +359,92 @@ class _Reader(Fields):
             t = self.table(data, "terrain", "terrain", _TERRAIN_KEYS)
             terrain = TerrainReach(*(self.number(t, key, "terrain", non_negative=True) for key in _TERRAIN_KEYS))
         health = read_health(self, data, joints)
-        return RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
-                           mass=mass, servo=servo, terrain=terrain, health=health)
+        balance = self.balance(self.optional_table(data, "balance", "balance", BalanceSettings.field_names()))
+        config = RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
+                             mass=mass, servo=servo, terrain=terrain, health=health, balance=balance, links=links,
+                             boom=boom)
+        self.three_d_checks(config)
+        return config
 
-    def mass(self, t: dict) -> MassSettings:
+    def mass(self, t: dict, links) -> MassSettings:
+        """The four planar segments, or with ``[links.*]`` only ``total_kg``, which must add up."""
+        if links is not None:
+            for key in _MASS_KEYS[:4]:
+                if key in t:
+                    raise self.fail(f"mass.{key}", "give link masses in [links.*] or segment masses in [mass], "
+                                                   "not both")
+            total = self.number(t, "total_kg", "mass", positive=True)
+            summed = sum(link.mass_kg * (1 if name == "torso" else 2) for name, link in links)
+            if abs(summed - total) > MASS_TOLERANCE_KG:
+                raise self.fail("mass.total_kg", f"{total:g} kg, but torso + 2 x the leg links add up to "
+                                                 f"{summed:.6f} kg (a mass table that does not add up)")
+            return MassSettings()
         defaults = MassSettings()
-        return MassSettings(**{k: self.number(t, k, "mass", positive=True, default=getattr(defaults, k))
-                               for k in _MASS_KEYS})
+        mass = MassSettings(**{k: self.number(t, k, "mass", positive=True, default=getattr(defaults, k))
+                               for k in _MASS_KEYS[:4]})
+        if "total_kg" in t:
+            total = self.number(t, "total_kg", "mass", positive=True)
+            if abs(mass.total_kg - total) > MASS_TOLERANCE_KG:
+                raise self.fail("mass.total_kg", f"{total:g} kg, but torso_kg + 2 x (thigh_kg + shank_kg + foot_kg) "
+                                                 f"= {mass.total_kg:.6f} kg")
+        return mass
+
+    def links(self, data: dict) -> tuple[tuple[str, LinkInertial], ...]:
+        """``[links.<name>]``: mass, centre of mass and inertia of the torso and the left leg's six links."""
+        tables = self.table(data, "links", "links", _LINK_NAMES)
+        out = []
+        for name in _LINK_NAMES:
+            f = f"links.{name}"
+            t = self.table(tables, name, f, _LINK_KEYS)
+            mass = self.number(t, "mass_kg", f, positive=name == "torso", non_negative=True)
+            com = self.vector(t, "com_m", f, 3, "[x, y, z] in metres")
+            inertia = inertia_matrix(*self.vector(t, "inertia_kg_m2", f, 6, "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] in kg m^2"))
+            moments = np.linalg.eigvalsh(inertia)
+            scale = max(float(moments.max()), 1e-12)
+            if moments.min() < -1e-9 * scale or moments.max() > moments.sum() - moments.max() + 1e-9 * scale:
+                raise self.fail(f"{f}.inertia_kg_m2", "is not the inertia of a rigid body (its principal moments "
+                                                      f"{', '.join(f'{m:.3g}' for m in moments)} must be >= 0 and "
+                                                      "none larger than the other two together)")
+            out.append((name, LinkInertial(mass, np.array(com), inertia)))
+        return tuple(out)
+
+    def vector(self, t: dict, key: str, f: str, length: int, what: str) -> list[float]:
+        value = self.require(t, key, f, what)
+        if not isinstance(value, list) or len(value) != length:
+            raise self.fail(f"{f}.{key}", f"must be {what}, got {kind(value)}")
+        return [self.check_number(v, f"{f}.{key}[{i}]") for i, v in enumerate(value)]
+
+    def balance(self, t: dict) -> BalanceSettings:
+        values = {}
+        for key in t:
+            if key == "sag_feedforward":
+                values[key] = self.boolean(t, key, "balance", default=True)
+                continue
+            lo, hi = BALANCE_LIMITS[key]
+            value = self.number(t, key, "balance")
+            if not lo <= value <= hi:
+                raise self.fail(f"balance.{key}", f"{value:g} is outside {lo:g}..{hi:g}")
+            values[key] = value
+        return BalanceSettings(**values)
+
+    def three_d_checks(self, config: RobotConfig) -> None:
+        """A robot whose legs roll needs a sole width, and roll limits that can keep its soles flat."""
+        if not config.is_3d:
+            return
+        if config.geometry.foot_width_m is None:
+            raise self.fail("geometry.foot_width_m", "missing (a robot with hip and ankle roll joints balances "
+                                                     "sideways on its soles: give their width in metres)")
+        g = config.geometry
+        needed = math.degrees(math.atan2(g.hip_width_m / 2 + g.sole_outward_m, g.thigh_m + g.shank_m))
+        for side in ("left", "right"):
+            hip, ankle = config.joint(f"hip_roll_{side}"), config.joint(f"ankle_roll_{side}")
+            # a flat sole under an upright torso has ankle_roll = -hip_roll
+            lo, hi = max(hip.min_deg, -ankle.max_deg), min(hip.max_deg, -ankle.min_deg)
+            if lo > -needed or hi < needed:
+                raise self.fail(f"joints.ankle_roll_{side}.min_deg" if hi < needed else f"joints.ankle_roll_{side}.max_deg",
+                                f"a flat sole needs ankle_roll = -hip_roll; to bring the body over one foot the hip "
+                                f"rolls {needed:.1f} deg either way, but with these limits the soles stay flat only "
+                                f"for hip_roll {lo:.1f}..{hi:.1f} deg")
 
     def servo(self, t: dict) -> ServoSettings:
         return ServoSettings(**{k: self.number(t, k, "servo", positive=True) if k in t else None
@@ -339,7 +470,12 @@ class _Reader(Fields):
             hip_width_m=self.number(t, "hip_width_m", f, positive=True),
             ankle_height_m=self.number(t, "ankle_height_m", f, non_negative=True, default=0.0),
             heel_back_m=self.number(t, "heel_back_m", f, non_negative=True, default=0.0),
+            foot_width_m=self.number(t, "foot_width_m", f, positive=True) if "foot_width_m" in t else None,
+            sole_outward_m=self.number(t, "sole_outward_m", f, default=0.0),
+            hip_below_root_m=self.number(t, "hip_below_root_m", f, non_negative=True, default=0.0),
         )
+        if geometry.foot_width_m is not None and geometry.foot_width_m <= 0:
+            raise self.fail("geometry.foot_width_m", f"must be a positive number, got {geometry.foot_width_m}")
         if geometry.heel_back_m >= geometry.foot_m:
             raise self.fail("geometry.heel_back_m", f"{geometry.heel_back_m} must be shorter than foot_m "
                                                     f"{geometry.foot_m} (the heel is behind the ankle, the toe ahead)")
@@ -375,29 +511,47 @@ class _Reader(Fields):
                            torque_off_on_exit=torque_off)
 
     def joints(self, data: dict, bus: BusSettings) -> tuple[JointConfig, ...]:
+        """Any mirrored set of leg joints that includes both legs' pitch joints; the moving ones first."""
         if "joints" not in data:
-            raise self.fail("joints", f"missing section (expected [joints.<name>] for {', '.join(WALKING_JOINTS)})")
+            raise self.fail("joints", f"missing section (expected [joints.<name>] for at least {', '.join(PITCH_JOINTS)})")
         tables = data["joints"]
         if not isinstance(tables, dict):
             raise self.fail("joints", f"must be tables [joints.<name>], got {kind(tables)}")
-        for name in WALKING_JOINTS:
+        for name in PITCH_JOINTS:
             if name not in tables:
-                others = [n for n in tables if n not in WALKING_JOINTS]
+                others = [n for n in tables if not is_leg_joint(n)]
                 close = difflib.get_close_matches(name, others, n=1)
                 hint = f"; is {close[0]!r} a typo of it?" if close else ""
-                raise self.fail(f"joints.{name}", f"missing walking joint (all of {', '.join(WALKING_JOINTS)} "
+                raise self.fail(f"joints.{name}", f"missing walking joint (all of {', '.join(PITCH_JOINTS)} "
                                                   f"are required{hint})")
-        order = list(WALKING_JOINTS) + [n for n in tables if n not in WALKING_JOINTS]
-        joints = tuple(self.joint(name, tables[name], bus) for name in order)
-        self.bus_wide_checks(joints, bus)
-        return joints
+        for name in tables:
+            if not is_leg_joint(name):
+                close = difflib.get_close_matches(name, LEG_JOINTS, n=1)
+                hint = f"did you mean {close[0]!r}? " if close else ""
+                raise self.fail(f"joints.{name}", f"unknown joint ({hint}allowed: {', '.join(LEG_JOINTS)})")
+        for name in canonical(tables):
+            if mirror(name) not in tables:
+                raise self.fail(f"joints.{mirror(name)}", f"missing: joints.{name} has no mirror on the other leg "
+                                                          f"(both legs must have the same joints)")
+        joints = {name: self.joint(name, tables[name], bus) for name in canonical(tables)}
+        for name, joint in joints.items():
+            other = joints[mirror(name)]
+            if joint.hold_deg is None and other.hold_deg is not None:
+                raise self.fail(f"joints.{name}.hold_deg", f"missing: joints.{other.name} is held at "
+                                                           f"{other.hold_deg:g} deg, so its mirror must be held too "
+                                                           f"(or remove hold_deg from both to walk with them)")
+        moving = [j for j in joints.values() if j.hold_deg is None]
+        held = [j for j in joints.values() if j.hold_deg is not None]
+        ordered = tuple(moving + held)
+        self.bus_wide_checks(ordered, bus)
+        return ordered
 
     def joint(self, name: str, t: Any, bus: BusSettings) -> JointConfig:
         f = f"joints.{name}"
         if not isinstance(t, dict):
             raise self.fail(f, f"must be a table [{f}], got {kind(t)}")
         self.no_unknown_keys(t, f, _JOINT_KEYS)
-        walking = name in WALKING_JOINTS
+        walking = split_joint(name)[0] in PITCH_KINDS
 
         model_name = self.string(t, "model", f, f"a servo model ({', '.join(SERVO_MODELS)})")
         if model_name not in SERVO_MODELS:
@@ -438,11 +592,10 @@ class _Reader(Fields):
         max_acceleration_dps2 = self.number(t, "max_acceleration_dps2", f, positive=True)
 
         hold_deg: float | None = None
-        if walking:
-            if "hold_deg" in t:
-                raise self.fail(f"{f}.hold_deg", "only non-walking joints are held at a fixed angle; "
-                                                 "remove it from a walking joint")
-        else:
+        if "hold_deg" in t:
+            if walking:
+                raise self.fail(f"{f}.hold_deg", "only non-walking joints (roll and yaw) may be held: the walk "
+                                                 "moves every hip, knee and ankle pitch joint")
             hold_deg = self.number(t, "hold_deg", f)
             if not min_deg <= hold_deg <= max_deg:
                 raise self.fail(f"{f}.hold_deg", f"{hold_deg} is outside the joint's limits {min_deg}..{max_deg} deg")

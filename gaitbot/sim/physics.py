@@ -23,7 +23,7 @@ from gaitbot.robot.config import RobotConfig
 class SimRobot:
     """The MuJoCo model of ``config``, standing straight at t = 0 with its servos limp.
 
-    Walking joints are indexed 0..5 in the config's (WALKING_JOINTS) order everywhere here.
+    Walking joints are indexed 0..5 in the config's (PITCH_JOINTS) order everywhere here.
     ``effort_peak``: per servo, the largest |commanded torque| / stall torque since the observers
     last reset it (1.0 = saturated); ``touch_steps``: per sole (left, right), timesteps in contact;
     ``full_torque_error_deg``: per servo, its stiffness now (factory until a gain is written).

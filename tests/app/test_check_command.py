@@ -18,7 +18,8 @@ from helpers import REPO_ROOT, PERIOD_S, ROBOTS, run_cli
 
 REPO = REPO_ROOT
 COLUMNS = ["t_s", "hip_pitch_left_deg", "knee_pitch_left_deg", "ankle_pitch_left_deg", "hip_pitch_right_deg",
-           "knee_pitch_right_deg", "ankle_pitch_right_deg", "root_x_m", "root_y_m"]
+           "knee_pitch_right_deg", "ankle_pitch_right_deg", "root_x_m", "root_y_m", "root_z_m"]
+VERSION_LINE = "# gaitbot trajectory 2"
 
 
 @pytest.fixture(scope="module")
@@ -37,14 +38,14 @@ def walks(tmp_path_factory):
 
 
 def load(path):
-    table = np.loadtxt(path, delimiter=",", skiprows=1)
-    assert Path(path).read_text().splitlines()[0].split(",") == COLUMNS
+    table = np.loadtxt(path, delimiter=",", skiprows=2)
+    assert Path(path).read_text().splitlines()[:2] == [VERSION_LINE, ",".join(COLUMNS)]
     return table
 
 
 def save(path, table):
     with open(path, "w") as f:
-        f.write(",".join(COLUMNS) + "\n")
+        f.write(VERSION_LINE + "\n" + ",".join(COLUMNS) + "\n")
         np.savetxt(f, table, delimiter=",", fmt="%.9g")
     return path
 

@@ -17,7 +17,7 @@ from gaitbot.robot.config import load_robot_config, resolve_config
 from gaitbot.robot.walk_settings import leg_geometry
 
 HEADER = ("t_s,hip_pitch_left_deg,knee_pitch_left_deg,ankle_pitch_left_deg,"
-          "hip_pitch_right_deg,knee_pitch_right_deg,ankle_pitch_right_deg,root_x_m,root_y_m")
+          "hip_pitch_right_deg,knee_pitch_right_deg,ankle_pitch_right_deg,root_x_m,root_y_m,root_z_m")
 XL430 = load_robot_config(resolve_config("xl430-biped"))
 XL430_LEG = leg_geometry(XL430)
 
@@ -52,7 +52,7 @@ def test_generate_csv(tmp_path, capsys):
     assert main(["generate", "--steps", "0.05,0.08", "-o", str(out)]) == 0
     assert "wrote" in capsys.readouterr().out
     lines = out.read_text().splitlines()
-    assert lines[0] == HEADER
+    assert lines[:2] == ["# gaitbot trajectory 2", HEADER]
     walk = Trajectory.load(out)
     np.testing.assert_allclose(walk.angles_rad[[0, -1]], 0.0, atol=1e-9)
     # the root travels the 0.13 m of the steps (it starts over the ankles, heel_back ahead of the heels at 0)

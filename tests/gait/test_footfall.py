@@ -35,7 +35,7 @@ def lowest_world_y(angles_rad, root):
 
 def test_the_root_from_contact_follows_the_walkers_own_root(walker):
     root, _ = root_from_contact(LEG, walker.angles_rad, walker.root_m[0])
-    assert np.abs(root[:, 1] - walker.root_m[:, 1]).max() < 1e-4  # heights: a tenth of a millimetre
+    assert np.abs(root[:, 1] - walker.root_xz_m[:, 1]).max() < 1e-4  # heights: a tenth of a millimetre
     # the walker and the read-back hand the support over at different moments of double support, where
     # the walker's rear toe and front heel do not quite agree: 2.8 mm over this 0.28 m walk
     assert np.abs(root[:, 0] - walker.root_m[:, 0]).max() < 0.02 * walker.root_m[-1, 0]
@@ -67,5 +67,5 @@ def test_swing_clearance_of_the_walker_holds_its_configured_clearance(walker):
     found = swing_clearances(LEG, walker)
     assert len(found) == len(walker.heel_strikes)
     assert min(c for _, c in found) >= SETTINGS.clearance
-    lower = walker.__class__(walker.t_s, walker.angles_rad, walker.root_m - [0.0, 0.005], walker.heel_strikes)
+    lower = walker.__class__(walker.t_s, walker.angles_rad, walker.root_m - [0.0, 0.0, 0.005], walker.heel_strikes)
     assert max(c for _, c in swing_clearances(LEG, lower)) < max(c for _, c in found)

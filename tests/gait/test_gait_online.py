@@ -33,7 +33,7 @@ def assert_same_as_offline(frames, geometry, steps, settings):
     off = generate_walk(geometry, steps, settings)
     assert len(t) == len(off)
     assert np.array_equal(q, off.angles_rad), f"angles differ by {np.abs(q - off.angles_rad).max():.3g} rad"
-    assert np.array_equal(r, off.root_m), f"root differs by {np.abs(r - off.root_m).max():.3g}"
+    assert np.array_equal(r, off.root_xz_m), f"root differs by {np.abs(r - off.root_xz_m).max():.3g}"
     np.testing.assert_allclose(t, off.t_s, rtol=0, atol=1e-12)
     np.testing.assert_allclose(np.diff(t), 1.0 / settings.rate_hz, atol=1e-12)
 

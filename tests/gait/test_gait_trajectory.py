@@ -9,6 +9,9 @@ from gaitbot.gait import TABLE1_LEG, Trajectory, TrajectoryFileError, generate_w
 
 HEADER = ("t_s,hip_pitch_left_deg,knee_pitch_left_deg,ankle_pitch_left_deg,"
           "hip_pitch_right_deg,knee_pitch_right_deg,ankle_pitch_right_deg,root_x_m,root_y_m")
+"""Format 1: the six pitch joints, root_y_m the height (files written before the 3D format still load)."""
+HEADER_V2 = ("t_s,hip_pitch_left_deg,knee_pitch_left_deg,ankle_pitch_left_deg,"
+             "hip_pitch_right_deg,knee_pitch_right_deg,ankle_pitch_right_deg,root_x_m,root_y_m,root_z_m")
 
 
 @pytest.fixture(scope="module")
@@ -20,10 +23,12 @@ def test_csv_round_trip(walk, tmp_path):
     path = tmp_path / "walk.csv"
     walk.save(path)
     lines = path.read_text().splitlines()
-    assert lines[0] == HEADER
-    assert len(lines) == len(walk) + 1
-    # the second row is the second frame, angles in degrees
-    row = [float(x) for x in lines[2].split(",")]
+    assert lines[0] == "# gaitbot trajectory 2"
+    assert lines[1] == HEADER_V2
+    assert len(lines) == len(walk) + 2
+    # the second row is the second frame, angles in degrees; the root in 3D with y = 0 (a planar walk)
+    row = [float(x) for x in lines[3].split(",")]
+    assert row[8] == 0.0 and row[9] == pytest.approx(walk.root_xz_m[1, 1], rel=1e-8)
     assert row[0] == pytest.approx(walk.t_s[1], rel=1e-8)
     np.testing.assert_allclose(row[1:7], np.degrees(walk.angles_rad[1]), rtol=1e-8, atol=1e-12)
     back = Trajectory.load(path)
@@ -48,7 +53,7 @@ def test_npz_round_trip(walk, tmp_path):
 
 def test_csv_columns_found_by_name(walk, tmp_path):
     """A file whose columns come in another order reads the same (columns are found by their header)."""
-    table = np.column_stack([walk.t_s, np.degrees(walk.angles_rad), walk.root_m])
+    table = np.column_stack([walk.t_s, np.degrees(walk.angles_rad), walk.root_xz_m])
     names = HEADER.split(",")
     order = [8, 0, 3, 1, 2, 7, 4, 5, 6]
     path = tmp_path / "shuffled.csv"

@@ -101,7 +101,7 @@ def make_walk(geometry: LegGeometry, steps, settings: WalkSettings | None = None
     pts = {}
     for j, leg in enumerate(LEGS):
         rel = fk_leg(traj.angles_rad[:, 3 * j:3 * j + 3], g.thigh, g.shank, g.foot, g.ankle_height, g.heel_back)
-        pts[leg] = {k: (v + traj.root_m if k != "pitch" else v) for k, v in rel.items()}
+        pts[leg] = {k: (v + traj.root_xz_m if k != "pitch" else v) for k, v in rel.items()}
     rate = 1.0 / (traj.t_s[1] - traj.t_s[0])
     return Walk(g, settings, list(steps), walker, traj, pts, rate)
 
@@ -288,7 +288,7 @@ def test_starts_and_ends_standing_feet_together(name):
     np.testing.assert_allclose(q[-1], 0.0, atol=1e-12)
     for i in (0, -1):
         assert w.pts["left"]["heel"][i, 0] == pytest.approx(w.pts["right"]["heel"][i, 0], abs=1e-12)
-        assert w.traj.root_m[i, 1] == pytest.approx(w.geometry.leg_length + w.geometry.ankle_height, abs=1e-12)
+        assert w.traj.root_xz_m[i, 1] == pytest.approx(w.geometry.leg_length + w.geometry.ankle_height, abs=1e-12)
     x0 = w.pts["left"]["heel"][0, 0]
     assert w.pts["left"]["heel"][-1, 0] == pytest.approx(x0 + sum(w.steps), abs=1e-9 * w.L)
 
@@ -370,7 +370,7 @@ def test_hundred_steps_same_height_no_drift():
     strikes = [s for s in w.walker.planned_steps if not s.closing]
     assert len(strikes) == 100
     frames = [w.frame(s.end_s) for s in strikes]
-    y = w.traj.root_m[frames, 1]
+    y = w.traj.root_xz_m[frames, 1]
     # the same pose at every heel strike of a constant walk: the body is exactly as high after 100 steps
     assert float(y.max() - y.min()) <= 1e-9, f"root height at heel strikes varies by {y.max() - y.min():.3g} L"
     # no drift: the hip sits the same distance behind the landing heel at every strike
@@ -379,8 +379,8 @@ def test_hundred_steps_same_height_no_drift():
     # steady state: step 50 and step 98 have the same whole root path, relative to their footholds
     a0, b0 = w.frame(strikes[49].start_s), w.frame(strikes[49].end_s)
     a1, b1 = w.frame(strikes[97].start_s), w.frame(strikes[97].end_s)
-    r0 = w.traj.root_m[a0:b0] - [strikes[49].foothold_m, 0]
-    r1 = w.traj.root_m[a1:b1] - [strikes[97].foothold_m, 0]
+    r0 = w.traj.root_xz_m[a0:b0] - [strikes[49].foothold_m, 0]
+    r1 = w.traj.root_xz_m[a1:b1] - [strikes[97].foothold_m, 0]
     np.testing.assert_allclose(r0, r1, atol=1e-9)
 
 
@@ -551,12 +551,12 @@ def _corrupt(name: str, root_fn=None, angles_fn=None) -> str:
     from gaitbot.gait import Trajectory
 
     w = walk_for(name)
-    root, angles = w.traj.root_m.copy(), w.traj.angles_rad.copy()
+    root, angles = w.traj.root_xz_m.copy(), w.traj.angles_rad.copy()
     if root_fn:
         root_fn(w, root)
     if angles_fn:
         angles_fn(w, angles)
-    traj = Trajectory(w.traj.t_s, angles, root, w.traj.heel_strikes)
+    traj = Trajectory.sagittal(w.traj.t_s, angles, root, w.traj.heel_strikes)
     g = w.geometry
     pts = {}
     for j, leg in enumerate(LEGS):

@@ -78,7 +78,7 @@ def judge(rb: Robot, walk, settings, treads):
     assert report.ok, report.first_error
     edges = [(a[1], max(a[2], b[2])) for a, b in zip(pieces, pieces[1:])]
     for side in (0, 1):
-        heel, toe = fk_feet(cfg, traj.angles_rad[:, 3 * side:3 * side + 3], traj.root_m)
+        heel, toe = fk_feet(cfg, traj.angles_rad[:, 3 * side:3 * side + 3], traj.root_xz_m)
         gap_heel = heel[:, 1] - height(pieces, heel[:, 0])
         gap_toe = toe[:, 1] - height(pieces, toe[:, 0])
         assert min(gap_heel.min(), gap_toe.min()) > -1e-4 * leg, "a foot point under the terrain"

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from gaitbot.gait.trajectory import WALKING_JOINTS
+from gaitbot.gait.joints import PITCH_JOINTS
 from gaitbot.robot.config import (
     ConfigError,
     RobotConfig,
@@ -75,7 +75,7 @@ def expect_error(tmp_path: Path, text: str, field: str, *words: str) -> ConfigEr
 def test_shipped_config_loads_with_walking_joints_first(name):
     config = load_robot_config(resolve_config(name))
     assert config.name == name
-    assert tuple(j.name for j in config.walking_joints) == WALKING_JOINTS
+    assert tuple(j.name for j in config.walking_joints) == PITCH_JOINTS
     assert all(j.hold_deg is None for j in config.walking_joints)
     assert all(j.hold_deg is not None for j in config.held_joints)
     assert len(set(config.ids)) == len(config.joints)
@@ -130,7 +130,7 @@ def test_joint_lookup_and_held_joint_order():
     config = load_robot_config(resolve_config("ax12a-biped"))
     assert config.joint("knee_pitch_right").direction == -1
     assert [j.name for j in config.held_joints] == ["hip_roll_left", "hip_roll_right"]
-    assert config.ids[:6] == (11, 13, 15, 12, 14, 16)  # WALKING_JOINTS order, not id order
+    assert config.ids[:6] == (11, 13, 15, 12, 14, 16)  # PITCH_JOINTS order, not id order
     with pytest.raises(KeyError):
         config.joint("elbow")
 

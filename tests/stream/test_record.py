@@ -233,7 +233,7 @@ def test_root_is_reconstructed_from_the_lower_foot_standing_on_the_ground(tmp_pa
                    clock=VirtualClock())
     g = CFG.geometry
     rec = Trajectory.load(out)
-    np.testing.assert_allclose(rec.root_m[:, 1], g.thigh_m + g.shank_m + g.ankle_height_m, atol=1e-9)
+    np.testing.assert_allclose(rec.root_m[:, 2], g.thigh_m + g.shank_m + g.ankle_height_m, atol=1e-9)
     np.testing.assert_allclose(rec.root_m[:, 0], 0.0, atol=1e-12)
 
 

@@ -129,7 +129,7 @@ def assemble_walk(model: EigenGaitModel, head: Trajectory, body: np.ndarray, bod
     for frame, leg in sorted(events):
         frame = min(frame, len(t) - 1)
         strikes.append(HeelStrike(float(t[frame]), leg, heel_x(g, angles, root, frame, leg)))
-    return Trajectory(t, angles, root, tuple(strikes))
+    return Trajectory.sagittal(t, angles, root, strikes)
 
 
 def _walker_part(geometry, settings, step_m: float, n_steps: int):

@@ -276,4 +276,4 @@ def _trajectory(walk: TerrainWalk) -> Trajectory:
     roots.append(r)
     angles, roots = np.concatenate(angles), np.concatenate(roots)
     t = np.arange(len(angles)) / walk.ctx.rate_hz
-    return Trajectory(t, angles, roots, tuple(walk.heel_strikes))
+    return Trajectory.sagittal(t, angles, roots, walk.heel_strikes)
