@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 
-from gaitbot.bus.base import Bus, BusError
+from gaitbot.bus.base import Bus, BusError, ReadBack
 
 
 class GoalOutsideLimits(BusError):
@@ -50,6 +50,9 @@ class LimitGuard(Bus):
 
     def read_present_ticks(self, ids: Iterable[int]) -> dict[int, int]:
         return self.inner.read_present_ticks(ids)
+
+    def read_back(self, servo_id: int, budget_s: float) -> ReadBack:
+        return self.inner.read_back(servo_id, budget_s)
 
     def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
         """Settings are not goals: passed on (the backend refuses a write to the goal or torque register)."""

@@ -13,7 +13,8 @@ from contextlib import contextmanager
 from types import ModuleType
 from typing import Any
 
-from gaitbot.bus.base import Bus, BusError, CorruptReplies, PortError, ServoLate, ServoStatusError, ServoTimeout
+from gaitbot.bus.base import (Bus, BusError, CorruptReplies, PortError, ReadBack, ServoLate, ServoStatusError,
+                              ServoTimeout)
 from gaitbot.servos import dynamixel, has_sync_read, max_servo_id, wire
 from gaitbot.servos.models import ServoModel
 from gaitbot.servos.status import describe_status_error, hardware_error_address
@@ -30,10 +31,23 @@ LIST_PORTS_HINT = "list serial ports with: python -m serial.tools.list_ports -v"
 #: other end stopped reading). A 60 Hz frame is at most a few hundred bytes, so half a second
 #: is only ever reached when the port is dead.
 WRITE_TIMEOUT_S = 0.5
-#: After a status packet did not come within the SDK's reply timeout, listen this long for it.
-#: A reply arriving now was late, not lost: the servo (or the adapter) is too slow, and its next
-#: answers would be taken for answers to later questions, so the bus stops (ServoLate).
-LATE_REPLY_WATCH_MS = 40.0
+#: Blocking exchanges (ping, torque, settings, the start-up reads): after a status packet did not come
+#: within the SDK's reply timeout, listen this long for it before asking again. A reply arriving now
+#: was late, not lost: the servo (or the adapter) is too slow, and its answers would be taken for
+#: answers to later questions, so the bus stops (ServoLate) naming it. Long enough that a servo up to
+#: about 230 ms late at start-up is named before any goal is written.
+LATE_REPLY_WATCH_MS = 200.0
+#: The per-frame read-back (``read_back``) asks for the register block with a length that differs
+#: from every earlier request of that servo still unanswered (base length + 0, 1, 2, ...), so a late
+#: reply to an abandoned read is never taken as the answer to a later one: the status packet must
+#: carry exactly the parameters asked for. This many lengths: at most this many reads unanswered.
+READ_BACK_LENGTHS = 5
+#: An abandoned read-back whose reply has not come after this long is written off as lost.
+STALE_REPLY_HORIZON_S = 1.0
+#: A read-back with less budget than this left in its frame is not sent (outcome "skipped").
+MIN_READ_BACK_BUDGET_S = 0.5e-3
+#: An attempt of a blocking exchange whose status packet came during the late-reply watch.
+LATE_REPLY = "late"
 #: Linux pseudo-terminal slaves (Unix98 ptys) have device majors 136..143.
 _PTY_MAJORS = range(136, 144)
 
@@ -88,6 +102,11 @@ class SdkBus(Bus):
         self._read_group: Any = None  # one GroupSyncRead per bus, re-addressed only when the ids change
         self._is_open = False
         self._timed_out_ids: set[int] = set()  # servos whose last attempt timed out (late-reply evidence)
+        #: The per-frame read-back's register block (address, length): present position; a wider block
+        #: (present position first) may be read instead, the present position is decoded from its start.
+        self.read_back_block = self._present
+        self._abandoned: dict[int, list[tuple[int, float]]] = {}  # servo -> [(length asked, sent at)] unanswered
+        self._late_seen: dict[int, float] = {}  # servo -> lateness of its latest reply to an abandoned read
         self.open_notes: list[str] = []  # how the port was opened, when that differs from the config
 
     # --- hooks for subclasses -------------------------------------------------------------
@@ -189,7 +208,11 @@ class SdkBus(Bus):
                             "port closed)", servo_id=servo_id) from exc
 
     def ping(self, servo_id: int) -> bool:
+        """True if the servo answers (retried). For a configured servo, a silent attempt is followed by the
+        late-reply watch: a reply that comes then is consumed (never taken as the answer to the next
+        attempt), and a servo whose every attempt was answered only late raises ServoLate, named."""
         self._require_open()
+        late = 0
         for _ in range(1 + self.retries):
             self._before_transaction()
             with self._port_guard(servo_id):
@@ -197,8 +220,13 @@ class SdkBus(Bus):
                 _model_number, result, error = self._ph.ping(self.port, servo_id)
             self._raise_on_port_failure(result, servo_id)
             if result == self.sdk.COMM_SUCCESS:
+                self._timed_out_ids.discard(servo_id)
                 self.last_status_errors[servo_id] = error
                 return True
+            if result == self.sdk.COMM_RX_TIMEOUT and servo_id in self.models:
+                late += self._watch_for_late_reply(servo_id)
+        if late:
+            raise self._late(servo_id, f"to {late} of {1 + self.retries} pings")
         return False
 
     def set_torque(self, ids: Iterable[int], enabled: bool) -> None:
@@ -290,6 +318,109 @@ class SdkBus(Bus):
             ticks = {servo_id: self._read_one(servo_id) for servo_id in wanted}
         return {servo_id: ticks[servo_id] for servo_id in wanted}
 
+    def read_back(self, servo_id: int, budget_s: float) -> ReadBack:
+        """One READ of ``read_back_block`` from ``servo_id`` that waits at most ``budget_s`` and is never
+        retried: the per-frame read of a walk session (docs/bus-faults.md, "The read-back").
+
+        Input left over from earlier exchanges is read and dropped first (a late reply among it is
+        matched to the abandoned read it answers, by id and length, and its lateness noted). The request
+        goes out through the SDK; the status packet is awaited on the port's packet timeout capped to the
+        budget, and accepted only if it has this servo's id, is a status packet and carries exactly the
+        parameters asked for. Error bits raise ServoStatusError (the Hardware Error Status is read in
+        what is left of the budget); a dead port raises PortError.
+        """
+        self._require_open()
+        self._model(servo_id)
+        late_s = self._late_seen.pop(servo_id, None)
+        if not budget_s >= MIN_READ_BACK_BUDGET_S:
+            return ReadBack(servo_id, "skipped", late_s=late_s)
+        start_s = time.monotonic()
+        address, base_length = self.read_back_block
+        abandoned = self._abandoned.setdefault(servo_id, [])
+        abandoned[:] = [(n, t) for n, t in abandoned if start_s - t < STALE_REPLY_HORIZON_S]
+        used = {n for n, _ in abandoned}
+        free = [base_length + extra for extra in range(READ_BACK_LENGTHS) if base_length + extra not in used]
+        if not free:  # every length still owed a reply: asking again could not be told apart
+            return ReadBack(servo_id, "missed", late_s=late_s)
+        length = free[0]
+        outcome, frame = self._budgeted_read(servo_id, address, length, budget_s, start_s)
+        late_s = self._late_seen.pop(servo_id, late_s)
+        if frame is None:
+            if outcome != "damaged":
+                abandoned.append((length, start_s))
+            return ReadBack(servo_id, outcome, late_s=late_s)
+        data = bytes(frame.params)
+        error = frame.error or 0
+        self.last_status_errors[servo_id] = error
+        self._timed_out_ids.discard(servo_id)
+        if error:
+            remaining_s = budget_s - (time.monotonic() - start_s)
+            raise self._status_error(servo_id, error, budget_s=remaining_s)
+        ticks = self._decode(data[:self._present[1]], self._model(servo_id))
+        return ReadBack(servo_id, "answered", ticks, data, error, late_s)
+
+    def _budgeted_read(self, servo_id: int, address: int, length: int, budget_s: float,
+                       start_s: float) -> tuple[str, wire.Frame | None]:
+        """Send READ(address, length) to ``servo_id`` through the SDK and wait for its status packet until
+        ``start_s + budget_s``: ("answered", frame), ("damaged", None) or ("missed", None)."""
+        self._before_transaction()
+        with self._port_guard(servo_id):
+            self._drop_stale_input()
+            result = self._ph.readTx(self.port, servo_id, address, length)
+            if result != self.sdk.COMM_SUCCESS:
+                self.port.is_using = False
+                self._raise_on_port_failure(result, servo_id)
+                return "missed", None
+            remaining_ms = max(0.0, budget_s - (time.monotonic() - start_s)) * 1000.0
+            try:
+                return self._await_status(servo_id, length, remaining_ms)
+            finally:
+                self.port.is_using = False  # readTx took the SDK's lock; no rxPacket of the SDK releases it
+
+    def _await_status(self, servo_id: int, length: int, timeout_ms: float) -> tuple[str, wire.Frame | None]:
+        framing = wire.framing_for(self.family, self.protocol)
+        self.port.setPacketTimeoutMillis(timeout_ms)  # the port's clock: virtual on the mock, real on a port
+        buffer = bytearray()
+        damaged = False
+        while True:
+            available = self.port.getBytesAvailable()
+            if available:
+                buffer += bytes(self.port.readPort(available))
+                for raw, is_packet in wire.split_complete(buffer, framing):
+                    if not is_packet:
+                        continue
+                    frame = wire.parse(raw, framing, status=True)
+                    if self._answers(frame, servo_id, length, framing):
+                        return "answered", frame
+                    if frame.packet_id == servo_id and not frame.checksum_ok:
+                        damaged = True
+                    else:
+                        self._note_stale_status(frame)
+            elif self.port.isPacketTimeout():
+                return ("damaged" if damaged else "missed"), None
+            else:
+                time.sleep(0.0002)
+
+    @staticmethod
+    def _answers(frame: wire.Frame, servo_id: int, length: int, framing: str) -> bool:
+        return (frame.checksum_ok and frame.packet_id == servo_id and len(frame.params) == length
+                and (framing == "v1" or frame.instruction == wire.INST_STATUS_V2))
+
+    def _note_stale_status(self, frame: wire.Frame) -> bool:
+        """A status packet that answers an abandoned read-back (same id, same length): note how late it
+        came and forget that request. True if it did."""
+        if not frame.checksum_ok:
+            return False
+        abandoned = self._abandoned.get(frame.packet_id)
+        if not abandoned:
+            return False
+        for k, (length, sent_s) in enumerate(abandoned):
+            if length == len(frame.params):
+                del abandoned[k]
+                self._late_seen[frame.packet_id] = time.monotonic() - sent_s
+                return True
+        return False
+
     # --- internals ------------------------------------------------------------------------
     def _sync_read(self, wanted: list[int]) -> dict[int, int]:
         """GroupSyncRead's exchange, but keeping each status packet's error byte (GroupSyncRead drops it)."""
@@ -348,16 +479,22 @@ class SdkBus(Bus):
         if error:
             raise self._status_error(servo_id, error)
 
-    def _status_error(self, servo_id: int, error: int) -> ServoStatusError:
+    def _status_error(self, servo_id: int, error: int, budget_s: float | None = None) -> ServoStatusError:
+        """ServoStatusError naming the fault; on Dynamixel 2.0 the Hardware Error Status is read once to say
+        what the Alert bit means: blocking, or within ``budget_s`` (the read-back's frame) when given."""
         model = self._model(servo_id)
         hardware = None
         address = hardware_error_address(model.name)
         if self.family == "dynamixel" and self.protocol == 2.0 and error & dynamixel.V2_ALERT and address is not None:
             try:  # one attempt: the message is better with it, the stop does not depend on it
-                with self._port_guard(servo_id):
-                    self._drop_stale_input()
-                    value, result, _ = self._ph.read1ByteTxRx(self.port, servo_id, address)
-                hardware = value if result == self.sdk.COMM_SUCCESS else None
+                if budget_s is None:
+                    with self._port_guard(servo_id):
+                        self._drop_stale_input()
+                        value, result, _ = self._ph.read1ByteTxRx(self.port, servo_id, address)
+                    hardware = value if result == self.sdk.COMM_SUCCESS else None
+                elif budget_s >= MIN_READ_BACK_BUDGET_S:
+                    outcome, frame = self._budgeted_read(servo_id, address, 1, budget_s, time.monotonic())
+                    hardware = frame.params[0] if frame is not None else None
             except BusError:
                 hardware = None
         fault = describe_status_error(self.family, self.protocol, error, hardware, model.name)
@@ -365,17 +502,20 @@ class SdkBus(Bus):
         return ServoStatusError(f"servo {servo_id} on {self.port_name} reports {fault} ({detail})",
                                 servo_id=servo_id, status_error=error, fault=fault)
 
-    def _failed_attempt(self, servo_id: int, result: int, outcomes: dict[int, list[int]]) -> None:
-        """Note one failed attempt; after a silent one, listen for the servo's late status packet."""
+    def _failed_attempt(self, servo_id: int, result: int, outcomes: dict[int, list]) -> None:
+        """Note one failed attempt; after a silent one, listen for the servo's late status packet (a late
+        reply is consumed there, so the next attempt's answer cannot be confused with it)."""
         self._raise_on_port_failure(result, servo_id)
+        if result == self.sdk.COMM_RX_TIMEOUT and self._watch_for_late_reply(servo_id):
+            result = LATE_REPLY
         outcomes.setdefault(servo_id, []).append(result)
-        if result == self.sdk.COMM_RX_TIMEOUT:
-            self._timed_out_ids.add(servo_id)
-            self._watch_for_late_reply(servo_id)
 
-    def _no_answer(self, servo_id: int, results: list[int], what: str) -> ServoTimeout:
+    def _no_answer(self, servo_id: int, results: list, what: str) -> ServoTimeout:
         attempts = len(results)
         result = results[-1]
+        if LATE_REPLY in results:
+            late = sum(r == LATE_REPLY for r in results)
+            return self._late(servo_id, f"in {late} of {attempts} {what}")
         if all(r == self.sdk.COMM_RX_CORRUPT for r in results):
             return CorruptReplies(
                 f"servo {servo_id} on {self.port_name} sent a damaged status packet (bad checksum/CRC) in all "
@@ -388,13 +528,16 @@ class SdkBus(Bus):
             f"{how}: no status packet within the reply timeout; check its power, cable, id and baud rate",
             result_code=result, servo_id=servo_id)
 
-    def _watch_for_late_reply(self, servo_id: int) -> None:
-        """Listen up to LATE_REPLY_WATCH_MS for a status packet of ``servo_id``; ServoLate if one comes.
+    def _watch_for_late_reply(self, servo_id: int) -> bool:
+        """After a silent attempt: listen up to LATE_REPLY_WATCH_MS for a status packet of ``servo_id``.
+        True if one came (it is consumed: the attempt was answered late); False if none (the servo stays
+        suspect, and a still later reply of it seen before any later exchange raises ServoLate).
 
         Uses the port's own timeout (MockPort's is virtual), so a dry run costs no wall-clock time.
         """
+        self._timed_out_ids.add(servo_id)
         if not callable(getattr(self.port, "setPacketTimeoutMillis", None)):
-            return
+            return False
         buffer = bytearray()
         with self._port_guard(servo_id):
             self.port.setPacketTimeoutMillis(LATE_REPLY_WATCH_MS)
@@ -403,16 +546,17 @@ class SdkBus(Bus):
                 if available:
                     buffer += bytes(self.port.readPort(available))
                     if self._status_packet_from(buffer, servo_id):
-                        raise self._late(servo_id)
+                        self._timed_out_ids.discard(servo_id)
+                        return True
                 elif self.port.isPacketTimeout():
-                    return
+                    return False
                 else:
                     time.sleep(0.0002)
 
-    def _late(self, servo_id: int) -> ServoLate:
-        return ServoLate(f"servo {servo_id} on {self.port_name} answered late: its status packet arrived after "
-                         "the reply timeout (about 34 ms at 1 Mbaud); check its Return Delay Time and the "
-                         "adapter's latency timer", servo_id=servo_id)
+    def _late(self, servo_id: int, how: str = "") -> ServoLate:
+        return ServoLate(f"servo {servo_id} on {self.port_name} answered late{' ' + how if how else ''}: its "
+                         "status packet arrived after the reply timeout (about 34 ms at 1 Mbaud); check its Return "
+                         "Delay Time and the adapter's latency timer", servo_id=servo_id)
 
     def _status_packet_from(self, data: bytes | bytearray, servo_id: int) -> bool:
         framing = wire.framing_for(self.family, self.protocol)
@@ -427,7 +571,7 @@ class SdkBus(Bus):
 
     def _write_confirmed(self, servo_id: int, address: int, data: bytes, raise_status: bool = True) -> None:
         """One WRITE instruction of ``data`` at ``address``, retried until the servo's status packet comes."""
-        result, error = self.sdk.COMM_SUCCESS, 0
+        result, error, late = self.sdk.COMM_SUCCESS, 0, 0
         for _ in range(1 + self.retries):  # rewriting the same bytes is harmless, so retry
             self._before_transaction()
             with self._port_guard(servo_id):
@@ -436,7 +580,11 @@ class SdkBus(Bus):
             self._raise_on_port_failure(result, servo_id)
             if result == self.sdk.COMM_SUCCESS:
                 break
+            if result == self.sdk.COMM_RX_TIMEOUT and self._watch_for_late_reply(servo_id):
+                late += 1
         else:
+            if late:
+                raise self._late(servo_id, f"to {late} of {1 + self.retries} writes to address {address}")
             shown = data[0] if len(data) == 1 else f"0x{data.hex()}"
             raise ServoTimeout(f"servo {servo_id} on {self.port_name} did not confirm writing {shown} to "
                                f"address {address} ({self._ph.getTxRxResult(result)})",
@@ -458,8 +606,14 @@ class SdkBus(Bus):
             pending = available()
             if pending:
                 stale = bytes(self.port.readPort(pending))
+                framing = wire.framing_for(self.family, self.protocol)
+                unmatched = bytearray()
+                for raw, is_packet in wire.split_complete(bytearray(stale), framing):
+                    if is_packet and self._note_stale_status(wire.parse(raw, framing, status=True)):
+                        continue  # a late reply to an abandoned read-back: noted, not an answer to anything
+                    unmatched += raw
                 for servo_id in sorted(self._timed_out_ids):
-                    if self._status_packet_from(stale, servo_id):
+                    if self._status_packet_from(unmatched, servo_id):
                         raise self._late(servo_id)
         reset = getattr(self.port, "reset_input_buffer", None)
         if callable(reset):

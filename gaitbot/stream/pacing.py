@@ -145,9 +145,10 @@ class Streamer:
     on_frame(k, stats) is called after frame k went out, in the loop's own time: keep it
     to reading the cheap fields of :class:`StreamStats` and printing now and then.
 
-    monitor() is called right after each write, inside the frame's bus time (``bus_call_s``
-    covers both): walk_session reads the servos back there, so that a servo that stops
-    answering or reports a fault ends the walk within a frame or two. It raises to stop.
+    monitor(deadline_s) is called right after each write with that frame's deadline, inside the
+    frame's bus time (``bus_call_s`` covers both): walk_session reads a servo back there within
+    what is left of the frame (gaitbot.stream.readback), so that a servo that stops answering or
+    reports a fault ends the walk within a few frames. It raises to stop.
 
     After ``run`` returns or raises, ``stats`` holds the figures so far,
     ``last_sent_ticks`` the last frame whose write was started (None before the first) and
@@ -161,7 +162,7 @@ class Streamer:
                  late_threshold_s: float = LATE_THRESHOLD_S,
                  min_frame_interval_s: float | None = None,
                  cpu_time_s: Callable[[], float] = time.process_time,
-                 monitor: Callable[[], None] | None = None) -> None:
+                 monitor: Callable[[float], None] | None = None) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be > 0, got {period_s}")
         self.bus = bus
@@ -202,10 +203,12 @@ class Streamer:
                 # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
                 # time: converting a whole one-hour walk up front would take ~100 MB.
                 bus.write_goal_ticks(dict(zip(ids, frames[k].tolist())))
-                if monitor is not None:
-                    monitor()
-                done_s = clock.now()
+                # The grid moves on as soon as the goals went out: whatever the read-back raises, the
+                # next frame sent (a stop ramp's first) is due one period after this one, not at once.
                 self.next_deadline_s = deadline_s + self.period_s
+                if monitor is not None:
+                    monitor(deadline_s)
+                done_s = clock.now()
                 stats._record(send_s - deadline_s, done_s - send_s)
                 stats.wall_s = done_s - start_s
                 if self.on_frame is not None:

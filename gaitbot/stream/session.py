@@ -14,10 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite, ServoTimeout
+from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite
 from gaitbot.stream.clock import Clock, MonotonicClock
 from gaitbot.stream.pacing import StreamStats, Streamer, as_tick_frames
 from gaitbot.stream.ramps import ramp_ticks, stop_ticks
+from gaitbot.stream.readback import ReadBackMonitor
 from gaitbot.stream.signals import Terminated, install_sigterm_handler, restore_sigterm_handler
 
 #: Exit codes by outcome, the shell's conventions (128 + SIGINT, 128 + SIGTERM).
@@ -116,9 +117,10 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
     reach the servos.
 
     ``monitor_servos``: after every frame of the start ramp, the walk and the final ramp one servo is
-    read back, each in turn, so a servo that stops answering or reports error bits ends the walk within
-    ``len(ids)`` frames plus the bus's bounded retries; the safe stop ramp is not read back (it must
-    reach the healthy servos whatever the faulty one does). ``handle_sigterm``: SIGTERM raises
+    read back within what is left of that frame (gaitbot.stream.readback: never waited on, never
+    retried inside a frame), so a servo that stops answering or reports error bits ends the walk
+    within ``len(ids)`` + READ_BACK_MISSES frames; the safe stop ramp is not read back (it must reach
+    the healthy servos whatever the faulty one does). ``handle_sigterm``: SIGTERM raises
     :class:`~gaitbot.stream.signals.Terminated` (main thread only; the old handler is restored).
     """
     ids = [int(i) for i in ids]
@@ -135,20 +137,10 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
         return stop_ticks(previous_ticks, last_ticks, stand, max_velocity_ticks_per_s, max_accel_ticks_per_s2,
                           period_s)
 
-    next_checked = [0]
-
-    def check_servos() -> None:
-        """Read one servo back per frame, in turn: each servo is checked every len(ids) frames, and
-        the frame's bus time grows by one status packet, not by len(ids) of them (protocols without
-        sync read would otherwise ask every servo on its own every frame)."""
-        servo_id = ids[next_checked[0] % len(ids)]
-        next_checked[0] += 1
-        if servo_id not in bus.read_present_ticks([servo_id]):
-            raise ServoTimeout(f"servo {servo_id} stopped answering reads during the walk", servo_id=servo_id)
+    read_back = ReadBackMonitor(bus, ids, clock, period_s) if monitor_servos else None
 
     def streamer(callback=None, monitored: bool = False) -> Streamer:
-        monitor = check_servos if (monitored and monitor_servos) else None
-        return Streamer(bus, ids, period_s, clock, callback, monitor=monitor)
+        return Streamer(bus, ids, period_s, clock, callback, monitor=read_back if monitored else None)
 
     old_handler = install_sigterm_handler() if handle_sigterm else None
     state = _SessionState()
