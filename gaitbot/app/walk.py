@@ -12,7 +12,7 @@ from gaitbot.app.hardware import serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, load_robot
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
-from gaitbot.bus.log import BusRecorder
+from gaitbot.bus.log import BusRecorder, RecordingFailed
 from gaitbot.check.preflight import preflight
 from gaitbot.robot.calibration import angles_to_ticks, standing_ticks
 from gaitbot.robot.gains import gain_notes, gain_writes
@@ -66,11 +66,19 @@ def run(args) -> int:
     if args.record:
         joints = {j.name: j.id for j in config.joints}
         recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now)
-    if sim is not None:
-        bus = guarded(config, sim.make_bus(clock.now, recorder))
-    else:
-        bus = make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,
-                             reply_timeout_ms=args.reply_timeout_ms)
+    try:  # the recording's header is written here, before anything is sent
+        if sim is not None:
+            bus = guarded(config, sim.make_bus(clock.now, recorder))
+        else:
+            bus = make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,
+                                 reply_timeout_ms=args.reply_timeout_ms)
+    except (OSError, RecordingFailed) as exc:
+        if recorder is None:
+            raise
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        if isinstance(exc, RecordingFailed) and isinstance(exc.__cause__, OSError):
+            reason = exc.__cause__.strerror or exc.__cause__
+        raise UsageError(f"--record {args.record}: cannot write the recording ({reason}); nothing was sent") from None
     velocity, acceleration = joint_limits_ticks(config)
     for note in gain_notes(config):
         print(f"note: {note}", file=sys.stderr)

@@ -27,10 +27,11 @@ import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, BinaryIO
 
 import numpy as np
 
+from gaitbot.bus.base import BusError
 from gaitbot.errors import UserError
 from gaitbot.servos import BACKENDS, wire
 from gaitbot.servos.models import ServoModel, servo_model
@@ -42,6 +43,15 @@ _HEADER_KEYS = ("backend", "protocol", "baudrate", "robot", "joints", "models")
 
 class RecordingError(UserError, ValueError):
     """A bus log cannot be read; the message names the file, the line and the problem."""
+
+
+class RecordingFailed(BusError):
+    """The recording could not be written (a full disk, a failing drive) while the bus itself is fine.
+
+    Raised once, from the packet that could not be logged; the recorder then stops writing (what was
+    written stays, each line whole but possibly the last) and the session stops the walk with its
+    normal ramp, which still goes out on the healthy port. Not an OSError, so the bus never takes it
+    for a failure of the serial port."""
 
 
 # ---------------------------------------------------------------------------------------------- writing
@@ -57,7 +67,9 @@ class BusRecorder:
         self.joints = dict(joints)
         self._clock = clock
         self._t0_s: float | None = None
-        self._file: TextIO | None = None
+        self._file: BinaryIO | None = None
+        self.failed: OSError | None = None  # the write that failed; nothing is written after it
+        self.lines_written = 0
 
     def start(self, *, backend: str, protocol: float, baudrate: int, models: Mapping[int, ServoModel]) -> None:
         """Open the file and write the header; the clock's zero is now."""
@@ -66,9 +78,13 @@ class BusRecorder:
         header = {"format": LOG_FORMAT, "version": LOG_VERSION, "backend": backend, "protocol": float(protocol),
                   "baudrate": int(baudrate), "robot": self.robot, "joints": self.joints,
                   "models": {str(i): m.name for i, m in models.items()}}
-        self._file = open(self.path, "w", encoding="utf-8")
+        self._file = open(self.path, "wb", buffering=0)  # one os-level write per line: no buffer to lose
         self._t0_s = self._clock()
-        self._write_line(header)
+        try:
+            self._write_line(header)
+        except RecordingFailed:
+            self.close()
+            raise
 
     def wrap(self, port_handler: Any, *, backend: str, protocol: float, baudrate: int,
              models: Mapping[int, ServoModel]) -> "RecordingPort":
@@ -77,6 +93,8 @@ class BusRecorder:
         return RecordingPort(port_handler, self, wire.framing_for(backend, protocol))
 
     def log(self, direction: str, data: bytes) -> None:
+        if self.failed is not None:
+            return  # the recording already failed (and said so once): the walk's stop goes on without it
         if self._file is None or self._t0_s is None:
             raise RuntimeError(f"recorder {self.path} not started")
         t_s = round(self._clock() - self._t0_s, 6)
@@ -84,7 +102,10 @@ class BusRecorder:
 
     def close(self) -> None:
         if self._file is not None:
-            self._file.close()
+            try:
+                self._file.close()
+            except OSError as exc:  # nothing is buffered; a failing close is only noted
+                self.failed = self.failed or exc
             self._file = None
 
     def __enter__(self) -> "BusRecorder":
@@ -95,8 +116,19 @@ class BusRecorder:
 
     def _write_line(self, obj: dict) -> None:
         assert self._file is not None
-        self._file.write(json.dumps(obj, separators=(",", ":")) + "\n")
-        self._file.flush()
+        data = (json.dumps(obj, separators=(",", ":")) + "\n").encode("utf-8")
+        try:
+            written = self._file.write(data)
+            while written is not None and written < len(data):  # a raw write may be short; finish the line
+                more = self._file.write(data[written:])
+                if not more:
+                    raise OSError(28, "No space left on device")
+                written += more
+        except OSError as exc:
+            self.failed = exc
+            raise RecordingFailed(f"the recording {self.path} could not be written ({exc.strerror or exc}) after "
+                                  f"{self.lines_written} lines; what was written is kept") from exc
+        self.lines_written += 1
 
 
 class RecordingPort:

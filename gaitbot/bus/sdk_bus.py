@@ -15,6 +15,7 @@ from typing import Any
 
 from gaitbot.bus.base import (Bus, BusError, CorruptReplies, PortError, ReadBack, ServoLate, ServoStatusError,
                               ServoTimeout)
+from gaitbot.bus.log import RecordingFailed
 from gaitbot.servos import dynamixel, has_sync_read, max_servo_id, wire
 from gaitbot.servos.models import ServoModel
 from gaitbot.servos.status import describe_status_error, hardware_error_address
@@ -199,13 +200,19 @@ class SdkBus(Bus):
         """Turn an OS-level failure of the port inside the SDK into PortError (never retried)."""
         try:
             yield
+        except RecordingFailed:  # the recorder under the port failed, not the port: the bus goes on
+            self._release_port()
+            raise
         except PORT_EXCEPTIONS as exc:
-            try:
-                self.port.is_using = False  # the SDK's lock, left taken by the exchange that failed
-            except AttributeError:
-                pass
+            self._release_port()
             raise PortError(f"serial port {self.port_name} failed: {exc} (the adapter was unplugged or the "
                             "port closed)", servo_id=servo_id) from exc
+
+    def _release_port(self) -> None:
+        try:
+            self.port.is_using = False  # the SDK's lock, left taken by the exchange that failed
+        except AttributeError:
+            pass
 
     def ping(self, servo_id: int) -> bool:
         """True if the servo answers (retried). For a configured servo, a silent attempt is followed by the

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite
+from gaitbot.bus.log import RecordingFailed
 from gaitbot.stream.clock import Clock, MonotonicClock
 from gaitbot.stream.pacing import StreamStats, Streamer, as_tick_frames
 from gaitbot.stream.ramps import ramp_ticks, stop_ticks
@@ -92,6 +93,8 @@ class SessionResult:
         head = {"completed": "Walk completed", "interrupted": "Walk interrupted (Ctrl-C)",
                 "terminated": "Walk terminated (SIGTERM)", "bus_error": "Walk stopped by a bus error"}
         parts = [head.get(self.outcome, self.outcome)]
+        if isinstance(self.error, RecordingFailed):
+            parts = ["Walk stopped because the recording failed (the serial port is fine)"]
         if self.error is not None:
             parts.append(f"error: {self.error}")
         parts.extend(self.notes)
@@ -157,6 +160,7 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             first_sent_s = clock.now()
             bus.write_goal_ticks(dict(zip(ids, first_goal.tolist())))
             state.last_sent = first_goal
+            state.last_send_s = first_sent_s
             state.torque_on = True  # before the call: a torque-on that fails halfway still gets its torque-off
             bus.set_torque(ids, True)
             state.next_deadline_s = first_sent_s + period_s
@@ -206,12 +210,14 @@ class _SessionState:
         self.walk_stats: StreamStats | None = None
         self.notes: list[str] = []
         self.next_deadline_s: float | None = None  # keeps consecutive runs on one frame grid
+        self.last_send_s: float | None = None  # when the last frame went out: the pacing rule across runs
 
     def run(self, streamer: Streamer, frames: np.ndarray, is_walk: bool = False) -> None:
         try:
-            stats = streamer.run(frames, self.next_deadline_s)
+            stats = streamer.run(frames, self.next_deadline_s, self.last_send_s)
         finally:
             self.next_deadline_s = getattr(streamer, "next_deadline_s", self.next_deadline_s)
+            self.last_send_s = getattr(streamer, "last_send_s", None) or self.last_send_s
             if streamer.last_sent_ticks is not None:
                 before = streamer.previous_sent_ticks
                 self.previous_sent = before if before is not None else self.last_sent
