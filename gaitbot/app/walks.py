@@ -26,6 +26,15 @@ def build_walk(args) -> tuple[GaitSource, OnlineWalker]:
         return source, plan_walk(source.geometry, steps, source.settings)
     except StepLengthError as exc:
         raise UsageError(str(exc)) from None
+    except GaitGenerationError as exc:
+        raise UsageError(f"{leg_origin(args, source)}: {exc}") from None
+
+
+def leg_origin(args, source: GaitSource) -> str:
+    """Where the leg and gait settings of a walk come from, for a message about a walk they cannot make."""
+    flags = [f"--{name}" for name in ("thigh", "shank", "foot", "clearance", "rate") if getattr(args, name, None) is not None]
+    where = f"{source.robot.path}: geometry and gait" if source.robot is not None else "the leg"
+    return where + (f" with {', '.join(flags)}" if flags else "")
 
 
 @dataclass(frozen=True)

@@ -42,7 +42,7 @@ LATE_REPLY_WATCH_MS = 200.0
 #: from every earlier request of that servo still unanswered (base length + 0, 1, 2, ...), so a late
 #: reply to an abandoned read is never taken as the answer to a later one: the status packet must
 #: carry exactly the parameters asked for. This many lengths: at most this many reads unanswered.
-READ_BACK_LENGTHS = 5
+READ_BACK_LENGTHS = 8
 #: An abandoned read-back whose reply has not come after this long is written off as lost.
 STALE_REPLY_HORIZON_S = 1.0
 #: A read-back with less budget than this left in its frame is not sent (outcome "skipped").

@@ -5,8 +5,8 @@ After the goals of frame k go out (at its deadline d), one servo is read with a 
 ``d + period - READ_BACK_MARGIN_S``, so the read never delays frame k + 1. A read that cannot finish in
 its budget is abandoned for that frame (the bus never retries it inside the frame, and tells a late
 reply to it from the answer to any later read: gaitbot.bus.sdk_bus). Servos are read in turn; a servo
-that missed is read again in the next frames until it answers, and ``READ_BACK_MISSES`` misses in a
-row stop the walk naming it (ServoTimeout, ServoLate or CorruptReplies). docs/bus-faults.md has the
+that missed is read again in the next frames until it answers; ``READ_BACK_MISSES`` misses in a row
+over at least ``READ_BACK_SILENCE_S`` stop the walk naming it (ServoTimeout, ServoLate or CorruptReplies). docs/bus-faults.md has the
 policy and its timing figures.
 
 Kept general on purpose: :class:`ReadBackMonitor` reads whatever register block the bus's
@@ -21,8 +21,15 @@ from collections.abc import Callable, Sequence
 from gaitbot.bus.base import Bus, CorruptReplies, ReadBack, ServoLate, ServoTimeout
 from gaitbot.stream.clock import Clock
 
-#: Misses in a row (no status packet answering the read within its frame's budget) that stop a walk.
-READ_BACK_MISSES = 4
+#: A servo stops the walk when it has missed this many read-backs in a row (no status packet answering
+#: the read within its frame's budget), each with a fair budget, over at least READ_BACK_SILENCE_S.
+READ_BACK_MISSES = 3
+#: ... and the first of those misses was asked this long ago: a host or adapter that stalls for less
+#: (a busy machine, one USB hiccup) does not stop a walk; a servo silent or late by more does.
+READ_BACK_SILENCE_S = 0.1
+#: A miss counts only if its budget was at least this share of a frame's (period - margin): a frame
+#: that started late leaves its read little time, and a miss then says more about the host than the servo.
+FAIR_BUDGET_SHARE = 0.5
 #: The read-back's budget ends this long before the next frame's deadline: room for the clock's wake-up
 #: (the MonotonicClock spins its last 1.5 ms) so the next goals still go out on time.
 READ_BACK_MARGIN_S = 2.0e-3
@@ -31,11 +38,13 @@ READ_BACK_MARGIN_S = 2.0e-3
 class ReadBackMonitor:
     """Called by the Streamer after each frame's goal write with that frame's deadline; raises to stop.
 
-    ``misses_allowed``: misses in a row of one servo that still do not stop the walk (READ_BACK_MISSES - 1).
+    ``misses`` and ``silence_s``: a servo stops the walk after that many fair misses in a row spanning at
+    least that long (READ_BACK_MISSES, READ_BACK_SILENCE_S).
     """
 
     def __init__(self, bus: Bus, ids: Sequence[int], clock: Clock, period_s: float, *,
-                 misses: int = READ_BACK_MISSES, margin_s: float = READ_BACK_MARGIN_S,
+                 misses: int = READ_BACK_MISSES, silence_s: float = READ_BACK_SILENCE_S,
+                 margin_s: float = READ_BACK_MARGIN_S,
                  on_answer: Callable[[ReadBack], None] | None = None) -> None:
         if misses < 1:
             raise ValueError(f"misses must be >= 1, got {misses}")
@@ -44,7 +53,10 @@ class ReadBackMonitor:
         self.clock = clock
         self.period_s = float(period_s)
         self.misses = int(misses)
+        self.silence_s = float(silence_s)
         self.margin_s = min(float(margin_s), 0.25 * self.period_s)
+        self.fair_budget_s = FAIR_BUDGET_SHARE * (self.period_s - self.margin_s)
+        self.first_miss_s: dict[int, float] = {}  # servo -> when the first read of its current run of misses began
         self.on_answer = on_answer
         self.next_index = 0
         self.suspect: int | None = None  # the servo that missed last: read again until it answers
@@ -61,6 +73,7 @@ class ReadBackMonitor:
         else:
             servo_id = self.ids[self.next_index % len(self.ids)]
         budget_s = self.budget_s(deadline_s)
+        asked_s = self.clock.now()
         result = self.bus.read_back(servo_id, budget_s)
         self.reads += 1
         if result.outcome == "skipped":
@@ -68,16 +81,20 @@ class ReadBackMonitor:
             return
         if result.outcome == "answered":
             self.missed.pop(servo_id, None)
+            self.first_miss_s.pop(servo_id, None)
             if self.suspect == servo_id:
                 self.suspect = None
             self.next_index += 1
             if self.on_answer is not None:
                 self.on_answer(result)
             return
+        self.suspect = servo_id
+        self.first_miss_s.setdefault(servo_id, asked_s)
+        if budget_s < self.fair_budget_s:
+            return  # read again next frame; this miss is the frame's lateness as much as the servo's
         misses = self.missed.setdefault(servo_id, [])
         misses.append(result)
-        self.suspect = servo_id
-        if len(misses) >= self.misses:
+        if len(misses) >= self.misses and self.clock.now() - self.first_miss_s[servo_id] >= self.silence_s:
             raise self.error(servo_id, misses, budget_s)
 
     def error(self, servo_id: int, misses: list[ReadBack], budget_s: float) -> ServoTimeout:
