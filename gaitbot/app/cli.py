@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
 
 from gaitbot import __version__
-from gaitbot.bus.base import BusError
 from gaitbot.errors import UserError
+from gaitbot.stream.signals import StopSignals, Terminated  # light: the rooms are imported by the commands
 
 #: Subcommand -> the module of gaitbot.app whose ``run(args)`` does it (imported when used: ``plot``
 #: needs matplotlib, ``walk --sim`` MuJoCo, and the rest should not wait for them).
@@ -38,8 +39,16 @@ def _walk_inputs(p: argparse.ArgumentParser) -> None:
                    "--steps/--distance")
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line (the program, the error, where to look) and exit 2: no usage
+    block around it (``--help`` still prints the usage)."""
+
+    def error(self, message: str):  # noqa: D401 - argparse's name
+        self.exit(2, f"{self.prog}: error: {' '.join(message.split())} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="gaitbot", description="Walking gaits for small servo bipeds.")
+    parser = OneLineParser(prog="gaitbot", description="Walking gaits for small servo bipeds.")
     parser.add_argument("--version", action="version", version=f"gaitbot {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -136,6 +145,23 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    signals = StopSignals()  # first: a Ctrl-C from here on is one line and exit 130, never a traceback
+    signals.install()
+    try:
+        return _main(argv, signals)
+    except (KeyboardInterrupt, Terminated):  # while parsing or importing, before a command ran
+        terminated = signals.first_signal == signal.SIGTERM
+        print(f"gaitbot: {'terminated (SIGTERM)' if terminated else 'interrupted (Ctrl-C)'}; nothing was sent",
+              file=sys.stderr)
+        return 143 if terminated else 130
+    finally:
+        if signals.received:
+            signals.ignore_from_now()
+        else:
+            signals.restore()
+
+
+def _main(argv: list[str] | None, signals: StopSignals) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     sources = [name for name in ("steps", "distance", "terrain", "trajectory") if getattr(args, name, None) is not None]
@@ -146,8 +172,17 @@ def main(argv: list[str] | None = None) -> int:
             args.distance = 0.5  # the built-in demo: half a metre on the mock bus or the simulated robot
         else:
             parser.error(f"{args.command}: give --steps or --distance")
+    from gaitbot.bus.base import BusError  # imported here: the bus room brings the vendor SDKs and numpy
+
     try:
         return importlib.import_module(COMMANDS[args.command]).run(args)
+    except (KeyboardInterrupt, Terminated):  # before or after a session (a session handles its own)
+        if args.debug:
+            raise
+        terminated = signals.first_signal == signal.SIGTERM
+        print(f"gaitbot {args.command}: {'terminated (SIGTERM)' if terminated else 'interrupted (Ctrl-C)'}; "
+              "nothing more was sent", file=sys.stderr)
+        return 143 if terminated else 130
     except UserError as exc:
         if args.debug:
             raise
