@@ -61,11 +61,38 @@ MAX_TOML_CHARS = 1_000_000
 MAX_INTEGER = 2**53
 
 
+#: The largest file of each kind gaitbot reads (bytes): far beyond any real one, far below the machine.
+MAX_FILE_BYTES = 256 * 2**20
+
+
+def read_user_file(path: str | Path, max_bytes: int = MAX_FILE_BYTES) -> bytes:
+    """The bytes of a file a user named, read whole: it must be a regular file (a FIFO would block, a device
+    such as /dev/zero never ends) of at most ``max_bytes``. OSError (with a ``strerror`` for people) otherwise."""
+    import errno
+    import os
+    import stat
+
+    path = Path(path)
+    info = os.stat(path)  # FileNotFoundError, PermissionError, ELOOP ... as they are
+    if stat.S_ISDIR(info.st_mode):
+        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
+    if not stat.S_ISREG(info.st_mode):
+        raise OSError(errno.EINVAL, "not a regular file (a FIFO, a device or a socket)", str(path))
+    if info.st_size > max_bytes:
+        raise OSError(errno.EFBIG, f"{info.st_size} bytes, larger than the {max_bytes} bytes such a file may have",
+                      str(path))
+    with open(path, "rb") as f:
+        data = f.read(max_bytes + 1)
+    if len(data) > max_bytes:
+        raise OSError(errno.EFBIG, f"larger than the {max_bytes} bytes such a file may have", str(path))
+    return data
+
+
 def read_toml(path: str | Path, error: type[FieldError]) -> dict:
     """The parsed TOML file; ``error`` (a FieldError subclass) for a file that cannot be read or parsed."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_user_file(path, MAX_TOML_CHARS).decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise error.unreadable(path, exc) from None
     if len(text) > MAX_TOML_CHARS:

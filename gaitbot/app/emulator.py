@@ -14,6 +14,7 @@ packet received (default: at once). docs/emulator.md lists every option.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from gaitbot.bus.emulator import FAULT_KINDS, EmulatorConfig, Faults, ServoEmulator, hand_from_trajectory
@@ -42,9 +43,21 @@ def parse_ids(text: str) -> list[int]:
 
 def _id_value(text: str, what: str) -> tuple[int, str]:
     servo_id, sep, value = text.partition(":")
-    if not sep:
-        raise ValueError(f"{what} {text!r}: expected ID:VALUE")
+    if not sep or not servo_id.strip().isdigit():
+        raise ValueError(f"{what} {text!r}: expected ID:VALUE with a servo id, e.g. 3:{value or '60'}")
     return int(servo_id), value
+
+
+def check_fault_ids(faults: Faults, models) -> None:
+    """Every servo a fault names must be on the chain: a fault on a servo that is not there would be a test
+    that tests nothing."""
+    named = {"--silent": faults.silent, "--late": set(faults.late_s), "--error": set(faults.errors),
+             "--corrupt": faults.corrupt_ids or set()}
+    for flag, ids in named.items():
+        absent = sorted(i for i in ids if i not in models)
+        if absent:
+            raise ValueError(f"{flag}: servo {', '.join(map(str, absent))} is not on the chain "
+                             f"(ids {', '.join(map(str, sorted(models)))})")
 
 
 def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
@@ -53,11 +66,20 @@ def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
     faults.silent = set(args.silent or [])
     for item in args.late or []:
         servo_id, value = _id_value(item, "--late")
-        faults.late_s[servo_id] = float(value) / 1000.0
+        try:
+            late_ms = float(value)
+        except ValueError:
+            raise ValueError(f"--late {item!r}: MS must be a number of milliseconds") from None
+        if not (math.isfinite(late_ms) and 0 <= late_ms <= 10_000):
+            raise ValueError(f"--late {item!r}: MS must be within 0..10000 ms")
+        faults.late_s[servo_id] = late_ms / 1000.0
     if args.corrupt:
         fraction, _, which = args.corrupt.partition(":")
-        faults.corrupt_fraction = float(fraction)
-        faults.corrupt_ids = {int(which)} if which else None
+        try:
+            faults.corrupt_fraction = float(fraction)
+            faults.corrupt_ids = {int(which)} if which else None
+        except ValueError:
+            raise ValueError(f"--corrupt {args.corrupt!r}: expected FRACTION[:ID], e.g. 0.5:3") from None
         if not 0.0 <= faults.corrupt_fraction <= 1.0:
             raise ValueError(f"--corrupt {args.corrupt!r}: the fraction must be within 0..1")
     for item in args.error or []:
@@ -68,6 +90,7 @@ def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
         faults.errors[servo_id] = kinds
     if args.robot:
         robot = load_robot_config(resolve_config(args.robot))
+        check_fault_ids(faults, robot.models_by_id)
         hand = hand_from_trajectory(robot, args.hand, args.hand_rate) if args.hand else None
         return EmulatorConfig(robot.bus.backend, robot.bus.protocol, robot.models_by_id,
                               args.baudrate or robot.bus.baudrate, faults, args.log, robot.name,
@@ -81,6 +104,7 @@ def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
     if model.family != backend or protocol not in model.protocols:
         raise ValueError(f"--model {model.name} does not speak {args.protocol}")
     models = {i: model for i in parse_ids(args.ids)}
+    check_fault_ids(faults, models)
     return EmulatorConfig(backend, protocol, models, args.baudrate or 1_000_000, faults, args.log,
                           seed=args.seed, return_delay_us=args.return_delay_us)
 

@@ -65,7 +65,8 @@ def run(args) -> int:
     recorder = None
     if args.record:
         joints = {j.name: j.id for j in config.joints}
-        recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now)
+        recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now,
+                               rate_hz=source.settings.rate_hz)
     try:  # the recording's header is written here, before anything is sent
         if sim is not None:
             bus = guarded(config, sim.make_bus(clock.now, recorder))

@@ -33,11 +33,14 @@ import numpy as np
 
 from gaitbot.bus.base import BusError
 from gaitbot.errors import UserError
+from gaitbot.fields import read_user_file
+from gaitbot.robot.config import RATE_RANGE_HZ
 from gaitbot.servos import BACKENDS, wire
 from gaitbot.servos.models import ServoModel, servo_model
 
 LOG_FORMAT = "gaitbot-bus-log"
 LOG_VERSION = 1
+MAX_HEADER_CHARS = 1_000_000
 _HEADER_KEYS = ("backend", "protocol", "baudrate", "robot", "joints", "models")
 
 
@@ -61,8 +64,9 @@ class BusRecorder:
     """Writes one bus log. ``clock`` returns seconds (monotonic); injectable for tests."""
 
     def __init__(self, path: str | Path, *, robot: str, joints: Mapping[str, int],
-                 clock: Callable[[], float] = time.monotonic) -> None:
+                 clock: Callable[[], float] = time.monotonic, rate_hz: float | None = None) -> None:
         self.path = Path(path)
+        self.rate_hz = rate_hz  # the frame rate of the run, written in the header (gaitbot check uses it)
         self.robot = robot
         self.joints = dict(joints)
         self._clock = clock
@@ -78,6 +82,8 @@ class BusRecorder:
         header = {"format": LOG_FORMAT, "version": LOG_VERSION, "backend": backend, "protocol": float(protocol),
                   "baudrate": int(baudrate), "robot": self.robot, "joints": self.joints,
                   "models": {str(i): m.name for i, m in models.items()}}
+        if self.rate_hz is not None:
+            header["rate_hz"] = float(self.rate_hz)
         self._file = open(self.path, "wb", buffering=0)  # one os-level write per line: no buffer to lose
         self._t0_s = self._clock()
         try:
@@ -234,11 +240,13 @@ def read_log(path: str | Path, *, allow_partial_last_line: bool = False) -> BusL
     cannot be read as a bus log; bad bytes inside a packet are left for the checks."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_user_file(path).decode("utf-8")
     except FileNotFoundError:
         raise RecordingError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RecordingError(f"{path}: cannot read ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise RecordingError(f"{path}: cannot read (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
+    except OSError as exc:
+        raise RecordingError(f"{path}: cannot read ({exc.strerror or exc})") from None
     lines = text.split("\n")
     dropped = None
     if lines and lines[-1] == "":
@@ -260,41 +268,80 @@ def read_header(path: str | Path) -> dict:
     """The validated header alone (the first line), without reading the rest of the file."""
     path = Path(path)
     try:
+        if not path.is_file():
+            read_user_file(path, 0)  # the reason: missing, a directory, a FIFO or a device
         with open(path, encoding="utf-8") as f:
-            first = f.readline()
+            first = f.readline(MAX_HEADER_CHARS)
     except FileNotFoundError:
         raise RecordingError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RecordingError(f"{path}: cannot read ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise RecordingError(f"{path}: cannot read (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
+    except OSError as exc:
+        raise RecordingError(f"{path}: cannot read ({exc.strerror or exc})") from None
     if not first.strip():
         raise RecordingError(f"{path}:1: empty file, no {LOG_FORMAT} header")
     return _header(path, first)
 
 
 def _header(path: Path, line: str) -> dict:
+    where = f"{path}:1"
     try:
         header = json.loads(line)
     except json.JSONDecodeError as exc:
-        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (line 1 is not JSON: {exc.msg})") from None
+        raise RecordingError(f"{where}: no {LOG_FORMAT} header (line 1 is not JSON: {exc.msg})") from None
+    except RecursionError:
+        raise RecordingError(f"{where}: no {LOG_FORMAT} header (line 1 is nested too deeply)") from None
     if not isinstance(header, dict) or header.get("format") != LOG_FORMAT:
-        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (the first line must be "
+        raise RecordingError(f"{where}: no {LOG_FORMAT} header (the first line must be "
                              f"{{\"format\": \"{LOG_FORMAT}\", ...}}; is the file a bus recording, complete from its start?)")
-    if header.get("version") != LOG_VERSION:
-        raise RecordingError(f"{path}:1: unsupported log version {header.get('version')!r} (reads {LOG_VERSION})")
+    if header.get("version") != LOG_VERSION or isinstance(header.get("version"), bool):
+        raise RecordingError(f"{where}: unsupported log version {_shown(header.get('version'))} (reads {LOG_VERSION})")
     missing = [k for k in _HEADER_KEYS if k not in header]
     if missing:
-        raise RecordingError(f"{path}:1: header lacks {', '.join(missing)}")
+        raise RecordingError(f"{where}: header lacks {', '.join(missing)}")
+    backend, protocol, baudrate = header["backend"], header["protocol"], header["baudrate"]
+    if not isinstance(backend, str) or backend not in BACKENDS:
+        raise RecordingError(f"{where}: header backend must be {' or '.join(BACKENDS)}, got {_shown(backend)}")
+    if not _is_number(protocol) or float(protocol) not in (1.0, 2.0):
+        raise RecordingError(f"{where}: header protocol must be 1.0 or 2.0, got {_shown(protocol)}")
+    if backend == "feetech" and float(protocol) != 1.0:
+        raise RecordingError(f"{where}: header protocol of a feetech bus must be 1.0, got {_shown(protocol)}")
+    if isinstance(baudrate, bool) or not isinstance(baudrate, int) or not 0 < baudrate <= 100_000_000:
+        raise RecordingError(f"{where}: header baudrate must be a whole number of bits per second, "
+                             f"got {_shown(baudrate)}")
+    if not isinstance(header["robot"], str):
+        raise RecordingError(f"{where}: header robot must be a name (a string), got {_shown(header['robot'])}")
+    if "rate_hz" in header:
+        low, high, _unit = RATE_RANGE_HZ
+        rate = header["rate_hz"]
+        if not _is_number(rate) or not low <= float(rate) <= high:
+            raise RecordingError(f"{where}: header rate_hz must be a frame rate within {low:g}..{high:g} Hz, "
+                                 f"got {_shown(rate)}")
     joints, models = header["joints"], header["models"]
     if not isinstance(joints, dict) or not isinstance(models, dict):
-        raise RecordingError(f"{path}:1: header joints and models must be objects")
-    try:
-        for name in typed_header(header)["models"].values():
+        raise RecordingError(f"{where}: header joints and models must be objects")
+    for name, servo_id in joints.items():
+        if isinstance(servo_id, bool) or not isinstance(servo_id, int) or not 0 <= servo_id <= 253:
+            raise RecordingError(f"{where}: header joints.{name} must be a servo id 0..253, got {_shown(servo_id)}")
+    for key, name in models.items():
+        if not key.isdigit() or not 0 <= int(key) <= 253 or not isinstance(name, str):
+            raise RecordingError(f"{where}: header models must map servo ids 0..253 to model names, got "
+                                 f"{_shown(key)}: {_shown(name)}")
+        try:
             servo_model(name)
-    except (TypeError, ValueError, KeyError) as exc:
-        raise RecordingError(f"{path}:1: bad header joints/models/protocol: {exc}") from None
-    if header["backend"] not in BACKENDS:
-        raise RecordingError(f"{path}:1: unknown backend {header['backend']!r} ({' or '.join(BACKENDS)})")
+        except (TypeError, ValueError, KeyError) as exc:
+            raise RecordingError(f"{where}: header models.{key}: {' '.join(str(exc).split())}") from None
     return header
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _shown(value: Any) -> str:
+    """A header value in a message: short, one line."""
+    text = json.dumps(value) if isinstance(value, (str, int, float, bool, type(None))) else type(value).__name__
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def typed_header(header: dict) -> dict:
@@ -309,17 +356,16 @@ def _line(path: Path, line_no: int, line: str) -> LogLine:
         obj = json.loads(line)
     except json.JSONDecodeError as exc:
         raise RecordingError(f"{path}:{line_no}: bad JSON ({exc.msg}); not a bus recording line") from None
+    except RecursionError:
+        raise RecordingError(f"{path}:{line_no}: nested too deeply; not a bus recording line") from None
     if not isinstance(obj, dict) or not all(k in obj for k in ("t", "dir", "hex")):
         raise RecordingError(f"{path}:{line_no}: not a packet line (needs t, dir, hex)")
-    try:
-        t_s = float(obj["t"])
-    except (TypeError, ValueError):
-        raise RecordingError(f"{path}:{line_no}: t is not a number: {obj['t']!r}") from None
-    if not math.isfinite(t_s):
-        raise RecordingError(f"{path}:{line_no}: t is not a finite number: {obj['t']!r}")
+    if not _is_number(obj["t"]):
+        raise RecordingError(f"{path}:{line_no}: t must be a finite number of seconds, got {_shown(obj['t'])}")
+    t_s = float(obj["t"])
     direction, hex_text = obj["dir"], obj["hex"]
-    if direction not in ("tx", "rx"):
-        raise RecordingError(f"{path}:{line_no}: dir must be \"tx\" or \"rx\", got {direction!r}")
+    if not isinstance(direction, str) or direction not in ("tx", "rx"):
+        raise RecordingError(f"{path}:{line_no}: dir must be \"tx\" or \"rx\", got {_shown(direction)}")
     if not isinstance(hex_text, str):
         raise RecordingError(f"{path}:{line_no}: hex must be a string")
     try:
