@@ -16,6 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from gaitbot.errors import UserError
+from gaitbot.fields import read_user_file
+from gaitbot.gait.npz_file import NpzProblem, numeric, read_npz
 
 WALKING_JOINTS = (
     "hip_pitch_left",
@@ -93,7 +95,7 @@ class Trajectory:
     def load(cls, path: str | Path) -> "Trajectory":
         """Read a ``.csv`` or ``.npz`` trajectory; raise TrajectoryFileError with a one-line reason."""
         path = Path(path)
-        if not path.is_file():
+        if not path.exists():
             raise TrajectoryFileError(f"{path}: no such file")
         if path.suffix == ".npz":
             return _load_npz(path)
@@ -148,10 +150,15 @@ def _from_table(path: Path, t: np.ndarray, angles_deg: np.ndarray, root: np.ndar
 
 def _load_csv(path: Path) -> Trajectory:
     try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TrajectoryFileError(f"{path}: cannot read ({exc})") from None
-    rows = list(csv.reader(io.StringIO(text)))
+        text = read_user_file(path).decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise TrajectoryFileError(f"{path}: cannot read (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
+    except OSError as exc:
+        raise TrajectoryFileError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    try:
+        rows = list(csv.reader(io.StringIO(text)))
+    except csv.Error as exc:  # a cell over the csv module's field limit, a NUL byte ...
+        raise TrajectoryFileError(f"{path}: not a CSV table ({exc})") from None
     if not rows:
         raise TrajectoryFileError(f"{path}: empty file (expected a header row {','.join(CSV_COLUMNS)})")
     header = [h.strip() for h in rows[0]]
@@ -175,19 +182,23 @@ def _load_csv(path: Path) -> Trajectory:
 
 def _load_npz(path: Path) -> Trajectory:
     try:
-        with np.load(path, allow_pickle=False) as z:
-            missing = [k for k in ("t_s", "angles_deg", "root_m") if k not in z.files]
-            if missing:
-                raise TrajectoryFileError(f"{path}: missing array {missing[0]!r} (needs t_s, angles_deg, root_m)")
-            t, ang, root = z["t_s"], z["angles_deg"], z["root_m"]
-            raw = z["heel_strikes"] if "heel_strikes" in z.files else np.zeros((0, 3))
-    except TrajectoryFileError:
-        raise
-    except Exception as exc:  # zipfile/ValueError/EOFError on a truncated or foreign file
-        raise TrajectoryFileError(f"{path}: not a readable .npz trajectory ({type(exc).__name__}: {exc})") from None
-    if ang.ndim != 2 or ang.shape[1] != 6 or ang.shape[0] != len(t) or root.shape != (len(t), 2):
+        arrays = read_npz(path)
+        missing = [k for k in ("t_s", "angles_deg", "root_m") if k not in arrays]
+        if missing:
+            raise TrajectoryFileError(f"{path}: missing array {missing[0]!r} (needs t_s, angles_deg, root_m)")
+        t = numeric(arrays, "t_s", 1)
+        ang = numeric(arrays, "angles_deg", 2, columns=6)
+        root = numeric(arrays, "root_m", 2, columns=2)
+        raw = numeric(arrays, "heel_strikes", 2, columns=3) if "heel_strikes" in arrays else np.zeros((0, 3))
+    except OSError as exc:
+        raise TrajectoryFileError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    except NpzProblem as exc:
+        raise TrajectoryFileError(f"{path}: {exc}") from None
+    if ang.shape[0] != len(t) or root.shape[0] != len(t):
         raise TrajectoryFileError(f"{path}: arrays have inconsistent shapes t_s{t.shape} angles_deg{ang.shape} root_m{root.shape}")
-    strikes = [HeelStrike(float(a), "left" if int(b) == 0 else "right", float(c)) for a, b, c in raw.reshape(-1, 3)]
+    if len(raw) and not np.isin(raw[:, 1], (0.0, 1.0)).all():
+        raise TrajectoryFileError(f"{path}: array 'heel_strikes': column 2 (the leg) must be 0 (left) or 1 (right)")
+    strikes = [HeelStrike(float(a), "left" if int(b) == 0 else "right", float(c)) for a, b, c in raw]
     return _from_table(path, t, ang, root, strikes)
 
 
@@ -215,6 +226,8 @@ def refuse_truncated_csv(path: str | Path) -> None:
     """A ``.csv`` whose last line has no newline is taken as truncated: ``generate`` always ends its files
     with one, and a row cut inside its last number would still parse."""
     path = Path(path)
+    if not path.is_file():
+        return  # Trajectory.load says what it is instead (missing, a directory, a FIFO, a device)
     try:
         with open(path, "rb") as f:
             f.seek(0, 2)
