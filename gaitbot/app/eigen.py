@@ -25,11 +25,13 @@ import numpy as np
 from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, cycles_from_trajectory, fit_model,
                                 synthesize_walk, walk_label)
 from gaitbot.gait.trajectory import WALKING_JOINTS, Trajectory
-from gaitbot.app.options import UsageError, load_robot
+from gaitbot.app.options import UsageError, check_output_path, load_robot, write_output
 from gaitbot.check.preflight import preflight
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 
 POSE_TOL_DEG = 0.1
+#: Synthesised cycles one `eigen synth` may ask for (each two steps).
+MAX_CYCLES = 500
 
 
 def run(args) -> int:
@@ -68,6 +70,7 @@ def run_fit(args) -> int:
     out = Path(args.output)
     if out.suffix != ".npz":
         raise UsageError(f"-o {out}: the model file must end in .npz")
+    check_output_path(out)
     config = load_robot(args.robot)
     geometry = leg_geometry(config)
     options = FitOptions(samples=args.samples, basis=args.basis, n_basis=args.n_basis, roughness=args.roughness,
@@ -76,7 +79,7 @@ def run_fit(args) -> int:
                          label_degree=args.label_degree)
     examples, rate = load_examples(args.examples, geometry, config.gait.rate_hz, config)
     model = fit_model(examples, geometry, rate, options, periodic=args.basis == "fourier")
-    model.save(out)
+    write_output(out, model.save)
     labels = sorted(set(np.round(model.labels, 6)))
     print(f"wrote {out}: {len(examples)} example cycles from {len(args.examples)} files, step lengths "
           f"{', '.join(f'{v:g}' for v in labels)} m")
@@ -136,6 +139,11 @@ def run_synth(args) -> int:
     out = Path(args.output)
     if out.suffix not in (".csv", ".npz"):
         raise UsageError(f"-o {out}: the output must end in .csv or .npz")
+    check_output_path(out)
+    if not 1 <= args.cycles <= MAX_CYCLES:
+        raise UsageError(f"--cycles must be 1..{MAX_CYCLES}, got {args.cycles}")
+    if args.pose_time is not None and not math.isfinite(args.pose_time):
+        raise UsageError(f"--pose-time must be a finite number of seconds, got {args.pose_time!r}")
     model = EigenGaitModel.load(args.model)
     config = load_robot(args.robot)
     if leg_geometry(config) != model.geometry:
@@ -145,6 +153,8 @@ def run_synth(args) -> int:
         value = getattr(args, name)
         if value is not None and not math.isfinite(value):
             raise UsageError(f"--{name.replace('_', '-')} must be a finite number of metres, got {value!r}")
+    if args.step_length < 0 or (args.to_step_length is not None and args.to_step_length < 0):
+        raise UsageError("step lengths must be 0 or more metres")
     if args.step_length > config.gait.max_step_m or (args.to_step_length or 0) > config.gait.max_step_m:
         raise UsageError(f"step lengths must be at most max_step_m = {config.gait.max_step_m:g} m ({config.name})")
     components = args.components
@@ -177,7 +187,7 @@ def run_synth(args) -> int:
         pose_report = (args.pose_time, worst)
     walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,
                            components=components, alphas=alphas)
-    walk.save(out)
+    write_output(out, walk.save)
     xs = [h.x_m for h in walk.heel_strikes]
     print(f"wrote {out}: {len(walk)} frames, {walk.t_s[-1]:.2f} s, {len(xs)} heel strikes, "
           f"{walk.root_m[-1, 0] - walk.root_m[0, 0]:.4f} m; step lengths {', '.join(f'{d:.4f}' for d in np.diff(xs))} m")
