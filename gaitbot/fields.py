@@ -104,7 +104,7 @@ def read_toml(path: str | Path, error: type[FieldError]) -> dict:
         raise error.not_toml(path, exc) from None
     except ValueError as exc:  # e.g. an integer beyond Python's 4300-digit conversion limit
         raise error(path, "file", f"TOML value not readable: {exc}") from None
-    except RecursionError:
+    except (RecursionError, MemoryError):
         raise error(path, "file", "nested too deeply (arrays or tables inside each other beyond what a config "
                                   "holds)") from None
 

@@ -10,6 +10,7 @@ import argparse
 import importlib
 import signal
 import sys
+import warnings
 
 from gaitbot import __version__
 from gaitbot.errors import UserError
@@ -172,6 +173,8 @@ def _main(argv: list[str] | None, signals: StopSignals) -> int:
             args.distance = 0.5  # the built-in demo: half a metre on the mock bus or the simulated robot
         else:
             parser.error(f"{args.command}: give --steps or --distance")
+    if not args.debug:  # an error is one line: no RuntimeWarning or library warning around it (--debug shows them)
+        warnings.simplefilter("ignore")
     from gaitbot.bus.base import BusError  # imported here: the bus room brings the vendor SDKs and numpy
 
     try:

@@ -27,6 +27,9 @@ class UsageError(UserError, ValueError):
 def load_robot(robot: str | None) -> RobotConfig:
     """The robot config named by ``--robot`` (a path or a shipped name), or the built-in default; a
     ``gait.rate_hz`` the bus cannot carry is refused at load (gaitbot.bus.budget)."""
+    if robot is not None and not robot.strip():
+        raise UsageError("--robot: empty name; give a .toml path or a shipped robot name (leave --robot out for "
+                         "the default robot)")
     try:
         path = resolve_config(robot) if robot else default_config_path()
         return load_robot_config(path, extra_checks=[bus_budget_check])
@@ -34,6 +37,13 @@ def load_robot(robot: str | None) -> RobotConfig:
         raise
     except (OSError, ValueError, KeyError) as exc:
         raise UsageError(f"--robot {robot}: {exc}") from None
+
+
+def file_option(value: str, flag: str) -> str:
+    """A file named on the command line: an empty name is refused (it would be read as the current folder)."""
+    if value is None or not str(value).strip():
+        raise UsageError(f"{flag}: empty file name")
+    return value
 
 
 def check_output_path(out: Path, flag: str = "-o") -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gaitbot.app.options import UsageError, check_output_path, gait_source, write_output
+from gaitbot.app.options import UsageError, check_output_path, file_option, gait_source, write_output
 from gaitbot.gait.eigen import is_model_file
 from gaitbot.gait.terrain.course_file import load_course
 from gaitbot.gait.trajectory import Trajectory
@@ -33,7 +33,7 @@ def run(args) -> int:
     source = gait_source(args)
     terrain = None
     if getattr(args, "terrain", None) is not None:
-        terrain = load_course(args.terrain).terrain
+        terrain = load_course(file_option(args.terrain, "--terrain")).terrain
     write_output(out, lambda path: plot_trajectory(trajectory, source.geometry, path, clearance=source.settings.clearance,
                                                    title=Path(args.file).name, terrain=terrain))
     print(f"wrote {out}")

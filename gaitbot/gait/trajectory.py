@@ -104,6 +104,12 @@ class Trajectory:
         raise TrajectoryFileError(f"{path}: unknown trajectory format {path.suffix!r} (allowed: .csv, .npz)")
 
 
+#: Values a trajectory file may hold (far beyond any walk; beyond them arithmetic on them overflows).
+MAX_TIME_S = 1e7
+MAX_ANGLE_DEG = 3600.0
+MAX_ROOT_M = 1e4
+
+
 class CsvTrajectoryWriter:
     """A trajectory CSV written row by row (``gaitbot record``), readable at every moment.
 
@@ -142,6 +148,10 @@ def _from_table(path: Path, t: np.ndarray, angles_deg: np.ndarray, root: np.ndar
     for name, values in (("t_s", t), ("joint angles", angles_deg), ("root", root)):
         if not np.all(np.isfinite(values)):
             raise TrajectoryFileError(f"{path}: column {name} holds a value that is not a finite number")
+    for name, values, bound, unit in (("t_s", t, MAX_TIME_S, "s"), ("joint angles", angles_deg, MAX_ANGLE_DEG, "deg"),
+                                      ("root", root, MAX_ROOT_M, "m")):
+        if np.any(np.abs(values) > bound):
+            raise TrajectoryFileError(f"{path}: column {name} holds a value beyond +-{bound:g} {unit}")
     if np.any(np.diff(t) <= 0):
         i = int(np.argmax(np.diff(t) <= 0)) + 1
         raise TrajectoryFileError(f"{path}: t_s must increase, but row {i + 1} has t_s={t[i]!r} after {t[i - 1]!r}")
