@@ -98,12 +98,15 @@ class BusRecorder:
         self.start(backend=backend, protocol=protocol, baudrate=baudrate, models=models)
         return RecordingPort(port_handler, self, wire.framing_for(backend, protocol))
 
-    def log(self, direction: str, data: bytes) -> None:
+    def now(self) -> float:
+        return self._clock()
+
+    def log(self, direction: str, data: bytes, at_s: float | None = None) -> None:
         if self.failed is not None:
             return  # the recording already failed (and said so once): the walk's stop goes on without it
         if self._file is None or self._t0_s is None:
             raise RuntimeError(f"recorder {self.path} not started")
-        t_s = round(self._clock() - self._t0_s, 6)
+        t_s = round((self._clock() if at_s is None else at_s) - self._t0_s, 6)
         self._write_line({"t": t_s, "dir": direction, "hex": bytes(data).hex()})
 
     def close(self) -> None:
@@ -152,8 +155,9 @@ class RecordingPort:
 
     def writePort(self, packet) -> int:  # noqa: N802 (SDK name)
         self._flush_rx(partial=True)
+        sent_s = self._recorder.now()  # stamped as it is handed to the port, not after (a busy host may pause there)
         written = self._inner.writePort(packet)
-        self._recorder.log("tx", bytes(packet))
+        self._recorder.log("tx", bytes(packet), at_s=sent_s)
         return written
 
     def readPort(self, length: int):  # noqa: N802
