@@ -191,6 +191,13 @@ def _main(argv: list[str] | None, signals: StopSignals) -> int:
             raise
         print(f"gaitbot {args.command}: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return exc.exit_status
+    except OSError as exc:  # a file named on the command line that the OS refuses (a name too long, a loop ...)
+        if args.debug:
+            raise
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"gaitbot {args.command}: error: {' '.join((where + (exc.strerror or str(exc))).split())}",
+              file=sys.stderr)
+        return 2
     except BusError as exc:  # a bus that fails outside a walk session (scan): one line, status 1
         if args.debug:
             raise
