@@ -57,6 +57,7 @@ class FieldError(UserError, ValueError):
 
 #: A hand-written TOML file larger than this is refused before parsing (the shipped ones are ~3 KB).
 MAX_TOML_CHARS = 1_000_000
+MAX_TOML_LINE_CHARS = 10_000
 #: No integer field of a hand-written file means anything beyond this (ids, ticks, baud rates).
 MAX_INTEGER = 2**53
 
@@ -98,6 +99,10 @@ def read_toml(path: str | Path, error: type[FieldError]) -> dict:
     if len(text) > MAX_TOML_CHARS:
         raise error(path, "file", f"{len(text)} characters, more than a hand-written file holds "
                                   f"(at most {MAX_TOML_CHARS})")
+    for number, line in enumerate(text.splitlines(), start=1):
+        if len(line) > MAX_TOML_LINE_CHARS:  # the TOML parser is slow on some very long lines (deep dotted keys)
+            raise error(path, f"line {number}", f"{len(line)} characters, more than a hand-written line holds "
+                                                f"(at most {MAX_TOML_LINE_CHARS})")
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -17,6 +17,7 @@ import argparse
 import math
 import sys
 
+from gaitbot.app.cli import OneLineParser
 from gaitbot.bus.emulator import FAULT_KINDS, EmulatorConfig, Faults, ServoEmulator, hand_from_trajectory
 from gaitbot.robot.config import load_robot_config, resolve_config
 from gaitbot.servos.models import servo_model
@@ -60,7 +61,24 @@ def check_fault_ids(faults: Faults, models) -> None:
                              f"(ids {', '.join(map(str, sorted(models)))})")
 
 
+def check_numbers(args: argparse.Namespace) -> None:
+    """Counts and times that cannot be negative (or not finite), and rates that must be positive."""
+    for flag in ("fault_after_frames", "close_after_frames"):
+        value = getattr(args, flag)
+        if value is not None and value < 0:
+            raise ValueError(f"--{flag.replace('_', '-')} must be 0 or more goal frames, got {value}")
+    for flag in ("fault_after_s", "close_after_s", "return_delay_us"):
+        value = getattr(args, flag)
+        if value is not None and not (math.isfinite(value) and 0 <= value <= 1e6):
+            raise ValueError(f"--{flag.replace('_', '-')} must be a number within 0..1e6, got {value!r}")
+    if args.baudrate is not None and not 0 < args.baudrate <= 100_000_000:
+        raise ValueError(f"--baudrate must be a positive bit rate, got {args.baudrate}")
+    if args.hand_rate is not None and not (math.isfinite(args.hand_rate) and 0 < args.hand_rate <= 1000):
+        raise ValueError(f"--hand-rate must be within 0..1000 Hz, got {args.hand_rate!r}")
+
+
 def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
+    check_numbers(args)
     faults = Faults(after_frames=args.fault_after_frames, after_s=args.fault_after_s,
                     close_after_frames=args.close_after_frames, close_after_s=args.close_after_s)
     faults.silent = set(args.silent or [])
@@ -110,7 +128,7 @@ def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(description="Emulate a Dynamixel/Feetech servo chain on a pty "
+    p = OneLineParser(prog="servo_emulator", description="Emulate a Dynamixel/Feetech servo chain on a pty "
                                             "(the first line printed is the device path).")
     p.add_argument("--robot", help="robot config (.toml path or shipped name): its bus and servos")
     p.add_argument("--protocol", choices=sorted(PROTOCOLS), help="without --robot: the chain's protocol")

@@ -75,6 +75,8 @@ def positive_option(value: float | None, flag: str, what: str) -> None:
 def check_reply_timeout(reply_timeout_ms: float | None) -> None:
     """``--reply-timeout-ms``: how long to wait for each status packet, if given."""
     positive_option(reply_timeout_ms, "--reply-timeout-ms", "a positive number of milliseconds")
+    if reply_timeout_ms is not None and reply_timeout_ms > MAX_REPLY_TIMEOUT_MS:
+        raise UsageError(f"--reply-timeout-ms must be at most {MAX_REPLY_TIMEOUT_MS:g} ms, got {reply_timeout_ms:g}")
 
 
 def check_rate_option(config: RobotConfig, rate_hz: float | None, label: str | None = None) -> None:
@@ -131,6 +133,9 @@ MAX_STEPS = 1000
 MAX_DISTANCE_M = 100.0
 #: --seed must fit numpy's seeding (an unsigned 32-bit integer here).
 MAX_SEED = 2**32 - 1
+#: The longest wait for one status packet --reply-timeout-ms may set (start-up exchanges; a frame's
+#: read-back is bounded by its frame anyway).
+MAX_REPLY_TIMEOUT_MS = 1000.0
 
 
 def parse_step_list(text: str) -> list[float]:
@@ -169,7 +174,8 @@ def step_lengths(args, source: GaitSource) -> list[float]:
             raise UsageError(f"--max-step {max_step:g} m is longer than this robot's longest step "
                              f"{source.max_step_m:.4g} m")
         if distance / max_step > MAX_STEPS:
-            raise UsageError(f"--distance {distance:g} m in steps of at most {max_step:g} m needs "
+            flag = "--max-step" if args.max_step is not None else "--distance"
+            raise UsageError(f"{flag}: --distance {distance:g} m in steps of at most {max_step:g} m needs "
                              f"{math.ceil(distance / max_step)} steps, more than the {MAX_STEPS} one walk may have")
         steps = steps_for_distance(distance, max_step)
     for i, value in enumerate(steps, start=1):

@@ -9,7 +9,7 @@ from __future__ import annotations
 import sys
 
 from gaitbot.app.hardware import serial_port, warn_about_latency
-from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, load_robot
+from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.log import BusRecorder, RecordingFailed
@@ -63,7 +63,8 @@ def run(args) -> int:
     if hardware:
         warn_about_latency(port)
     recorder = None
-    if args.record:
+    if args.record is not None:
+        file_option(args.record, "--record")
         joints = {j.name: j.id for j in config.joints}
         recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now,
                                rate_hz=source.settings.rate_hz)

@@ -108,6 +108,7 @@ class SdkBus(Bus):
         self.read_back_block = self._present
         self._abandoned: dict[int, list[tuple[int, float]]] = {}  # servo -> [(length asked, sent at)] unanswered
         self._late_seen: dict[int, float] = {}  # servo -> lateness of its latest reply to an abandoned read
+        self._damaged_seen: dict[int, int] = {}  # servo -> damaged status packets seen since its last read-back
         self.open_notes: list[str] = []  # how the port was opened, when that differs from the config
 
     # --- hooks for subclasses -------------------------------------------------------------
@@ -306,6 +307,8 @@ class SdkBus(Bus):
                 group.addParam(servo_id, data)
         self._before_transaction()
         with self._port_guard():
+            if self._abandoned_any():
+                self._collect_stale_input()  # before the SDK's clearPort drops a late reply unseen
             result = group.txPacket()
         self._raise_on_port_failure(result, None)
         if result != self.sdk.COMM_SUCCESS:
@@ -355,6 +358,8 @@ class SdkBus(Bus):
         if frame is None:
             if outcome != "damaged":
                 abandoned.append((length, start_s))
+            if outcome == "missed" and self._damaged_seen.pop(servo_id, 0):
+                outcome = "damaged"  # its reply to an earlier read came, damaged: the same fault, seen late
             return ReadBack(servo_id, outcome, late_s=late_s)
         data = bytes(frame.params)
         error = frame.error or 0
@@ -401,12 +406,16 @@ class SdkBus(Bus):
                         return "answered", frame
                     if frame.packet_id == servo_id and not frame.checksum_ok:
                         damaged = True
-                    else:
-                        self._note_stale_status(frame)
+                    elif not self._note_stale_status(frame) and not frame.checksum_ok \
+                            and self._abandoned.get(frame.packet_id):
+                        self._damaged_seen[frame.packet_id] = self._damaged_seen.get(frame.packet_id, 0) + 1
             elif self.port.isPacketTimeout():
                 return ("damaged" if damaged else "missed"), None
             else:
                 time.sleep(0.0002)
+
+    def _abandoned_any(self) -> bool:
+        return any(self._abandoned.values())
 
     @staticmethod
     def _answers(frame: wire.Frame, servo_id: int, length: int, framing: str) -> bool:
@@ -506,8 +515,22 @@ class SdkBus(Bus):
                 hardware = None
         fault = describe_status_error(self.family, self.protocol, error, hardware, model.name)
         detail = f"status error 0x{error:02X}" + (f", hardware error status 0x{hardware:02X}" if hardware else "")
-        return ServoStatusError(f"servo {servo_id} on {self.port_name} reports {fault} ({detail})",
-                                servo_id=servo_id, status_error=error, fault=fault)
+        exc = ServoStatusError(f"servo {servo_id} on {self.port_name} reports {fault} ({detail})",
+                               servo_id=servo_id, status_error=error, fault=fault)
+        exc.detail_pending = hardware is None and address is not None and bool(error & dynamixel.V2_ALERT) \
+            and self.family == "dynamixel" and self.protocol == 2.0  # read it once the robot is safe
+        return exc
+
+    def explain_status_error(self, exc: BusError) -> BusError:
+        """The same fault with the Hardware Error Status read (blocking, one attempt) if the read-back had no
+        time left for it in its frame: called by the session after the stop ramp, so the message says
+        which hardware error the Alert bit meant."""
+        if not (isinstance(exc, ServoStatusError) and getattr(exc, "detail_pending", False) and self._is_open):
+            return exc
+        try:
+            return self._status_error(exc.servo_id, exc.status_error)
+        except BusError:
+            return exc
 
     def _failed_attempt(self, servo_id: int, result: int, outcomes: dict[int, list]) -> None:
         """Note one failed attempt; after a silent one, listen for the servo's late status packet (a late
@@ -600,6 +623,31 @@ class SdkBus(Bus):
         if error and raise_status:
             raise self._status_error(servo_id, error)
 
+    def _collect_stale_input(self) -> bytes:
+        """Read whatever input is pending (a recording port logs it) and note the status packets among it
+        that answer abandoned read-backs (late, by id and length) or are damaged; return the rest.
+
+        Called before each goal write too: the SDK's txPacket clears the input buffer (Dynamixel's
+        clearPort), and a late reply dropped unseen could not be told from a lost one."""
+        available = getattr(self.port, "getBytesAvailable", None)
+        if not callable(available):
+            return b""
+        pending = available()
+        if not pending:
+            return b""
+        stale = bytes(self.port.readPort(pending))
+        framing = wire.framing_for(self.family, self.protocol)
+        unmatched = bytearray()
+        for raw, is_packet in wire.split_complete(bytearray(stale), framing):
+            if is_packet:
+                frame = wire.parse(raw, framing, status=True)
+                if self._note_stale_status(frame):
+                    continue  # a late reply to an abandoned read-back: noted, not an answer to anything
+                if not frame.checksum_ok and self._abandoned.get(frame.packet_id):
+                    self._damaged_seen[frame.packet_id] = self._damaged_seen.get(frame.packet_id, 0) + 1
+            unmatched += raw
+        return bytes(unmatched)
+
     def _drop_stale_input(self) -> None:
         """Discard bytes left over from an earlier, timed-out exchange before asking anew.
 
@@ -608,20 +656,10 @@ class SdkBus(Bus):
         bytes are read first (a recording port logs them, so the recording stays complete), and a
         status packet among them from a servo that timed out is a late reply: ServoLate.
         """
-        available = getattr(self.port, "getBytesAvailable", None)
-        if callable(available):
-            pending = available()
-            if pending:
-                stale = bytes(self.port.readPort(pending))
-                framing = wire.framing_for(self.family, self.protocol)
-                unmatched = bytearray()
-                for raw, is_packet in wire.split_complete(bytearray(stale), framing):
-                    if is_packet and self._note_stale_status(wire.parse(raw, framing, status=True)):
-                        continue  # a late reply to an abandoned read-back: noted, not an answer to anything
-                    unmatched += raw
-                for servo_id in sorted(self._timed_out_ids):
-                    if self._status_packet_from(unmatched, servo_id):
-                        raise self._late(servo_id)
+        unmatched = self._collect_stale_input()
+        for servo_id in sorted(self._timed_out_ids):
+            if self._status_packet_from(unmatched, servo_id):
+                raise self._late(servo_id)
         reset = getattr(self.port, "reset_input_buffer", None)
         if callable(reset):
             reset()

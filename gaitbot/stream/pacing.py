@@ -202,13 +202,20 @@ class Streamer:
         try:
             earliest_s = start_s if previous_send_s is None else max(start_s, previous_send_s + self.min_frame_interval_s)
             ticks = paced_deadlines(clock, self.period_s, start_s, self.min_frame_interval_s, earliest_s)
+            last_write_s = previous_send_s
+            min_interval_s = self.min_frame_interval_s
             for _, (k, deadline_s, send_s) in zip(range(count), ticks):
                 work_cpu_start = cpu()
-                self.last_send_s = send_s
-                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frames[k]
                 # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
                 # time: converting a whole one-hour walk up front would take ~100 MB.
-                bus.write_goal_ticks(dict(zip(ids, frames[k].tolist())))
+                goals = dict(zip(ids, frames[k].tolist()))
+                # The pacing rule on the wire itself: had the host paused between the previous frame's
+                # start and its write, this write still waits the minimum interval after that one.
+                if last_write_s is not None and clock.now() < last_write_s + min_interval_s:
+                    clock.sleep_until(last_write_s + min_interval_s)
+                last_write_s = self.last_send_s = clock.now()
+                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frames[k]
+                bus.write_goal_ticks(goals)
                 # The grid moves on as soon as the goals went out: whatever the read-back raises, the
                 # next frame sent (a stop ramp's first) is due one period after this one, not at once.
                 self.next_deadline_s = deadline_s + self.period_s

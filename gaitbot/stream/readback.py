@@ -27,8 +27,12 @@ READ_BACK_MISSES = 3
 #: ... and the first of those misses was asked this long ago: a host or adapter that stalls for less
 #: (a busy machine, one USB hiccup) does not stop a walk; a servo silent or late by more does (and so
 #: does a host too busy to hear its servos for that long: the walk is not under control then either).
-READ_BACK_SILENCE_S = 0.3
+READ_BACK_SILENCE_S = 0.5
 
+#: A miss counts (and makes its servo the one read again) only if its read had at least this long: a frame
+#: that started late leaves its read too little time, and such a miss says more about the host than
+#: the servo (the next servo in turn is read then, so every servo keeps being read).
+FAIR_BUDGET_S = 4.0e-3
 #: The read-back's budget ends this long before the next frame's deadline: room for the clock's wake-up
 #: (the MonotonicClock spins its last 1.5 ms) so the next goals still go out on time.
 READ_BACK_MARGIN_S = 2.0e-3
@@ -86,6 +90,10 @@ class ReadBackMonitor:
             if self.on_answer is not None:
                 self.on_answer(result)
             return
+        if budget_s < min(FAIR_BUDGET_S, 0.25 * self.period_s):
+            if self.suspect != servo_id:
+                self.next_index += 1
+            return
         self.suspect = servo_id
         self.first_miss_s.setdefault(servo_id, asked_s)
         misses = self.missed.setdefault(servo_id, [])
@@ -98,10 +106,13 @@ class ReadBackMonitor:
         count = len(misses)
         budget_ms = max(0.0, budget_s) * 1e3
         late = [m.late_s for m in misses if m.late_s is not None]
-        if all(m.outcome == "damaged" for m in misses):
+        damaged = sum(m.outcome == "damaged" for m in misses)
+        if damaged and not late:
+            some = "" if damaged == count else f"{damaged} of "
             return CorruptReplies(
-                f"servo {servo_id} on {port} sent a damaged status packet (bad checksum/CRC) in {count} read-backs "
-                "in a row; check its cable, connectors and the bus wiring", servo_id=servo_id)
+                f"servo {servo_id} on {port} sent a damaged status packet (bad checksum/CRC) in {some}{count} "
+                "read-backs in a row, and no good one; check its cable, connectors and the bus wiring",
+                servo_id=servo_id)
         if late:
             return ServoLate(
                 f"servo {servo_id} on {port} answers late: {count} read-backs in a row missed their frame's budget "

@@ -180,6 +180,12 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
                                    "the servos hold their last goal")
             else:
                 state.safe_stop(streamer, stop)
+                explain = getattr(bus, "explain_status_error", None)
+                if callable(explain):  # the robot is safe now: time to read what the fault was
+                    try:
+                        error = explain(exc)
+                    except (KeyboardInterrupt, Terminated):
+                        pass
         except Exception:
             state.safe_stop(streamer, stop)
             state.finish(bus, ids, torque_off_on_exit)

@@ -223,3 +223,17 @@ def test_late_replies_are_named_as_late():
 
     with pytest.raises(ServoLate, match="servo 3 .*answers late.*100 ms after the request"):
         run_monitor(Late(clock), clock, 200)
+
+
+def test_misses_in_frames_that_started_late_name_no_one_and_every_servo_is_still_read():
+    """A host late by 14 ms in every frame leaves each read ~1 ms: a servo missing then is not blamed (the
+    host is), and the reading moves on, so a real fault on another servo is still seen."""
+    clock = VirtualClock()
+    bus = ScriptedBus(clock, {1: "missed", 2: "missed"})
+    monitor = ReadBackMonitor(bus, [1, 2, 3, 4, 5, 6], clock, 1 / 60)
+    for k in range(120):
+        deadline = k / 60
+        clock.sleep_until(deadline + 0.014)  # every frame starts 14 ms late
+        monitor(deadline)
+    assert set(bus.reads) == {1, 2, 3, 4, 5, 6}
+    assert max(bus.reads.count(i) for i in range(1, 7)) - min(bus.reads.count(i) for i in range(1, 7)) <= 1

@@ -43,6 +43,10 @@ MODEL_KIND = "gaitbot-eigen-gait"
 MODEL_VERSION = 1
 
 
+#: The largest roughness penalty a fit takes (beyond it every motion is a straight line anyway).
+MAX_ROUGHNESS = 1e6
+
+
 class EigenModelError(UserError, ValueError):
     """Bad input to fitting or synthesis (too few examples, unreachable pose, ...): one line for people."""
 
@@ -74,8 +78,8 @@ class FitOptions:
             v = getattr(self, name)
             if not (0.0 < v <= 1.0):
                 raise EigenModelError(f"{name} must be in (0, 1], got {v}")
-        if not (self.roughness >= 0 and np.isfinite(self.roughness)):
-            raise EigenModelError(f"roughness must be a finite number, 0 or more, got {self.roughness}")
+        if not 0 <= self.roughness <= MAX_ROUGHNESS:
+            raise EigenModelError(f"roughness must be 0..{MAX_ROUGHNESS:g}, got {self.roughness}")
         if not self.pose_tolerance_deg >= 0:
             raise EigenModelError(f"pose_tolerance_deg must be 0 or more degrees (inf: none), got {self.pose_tolerance_deg}")
         if self.roughness < 0:
@@ -259,8 +263,8 @@ class EigenGaitModel:
         if basis_kind == "fourier" and n_basis % 2 == 0:
             raise NpzProblem(f"array 'n_basis': a Fourier basis needs an odd number, got {n_basis}")
         roughness = float(numeric(d, "roughness", 0))
-        if roughness < 0:
-            raise NpzProblem(f"array 'roughness' must be 0 or more, got {roughness:g}")
+        if not 0 <= roughness <= MAX_ROUGHNESS:
+            raise NpzProblem(f"array 'roughness' must be 0..{MAX_ROUGHNESS:g}, got {roughness:g}")
         axes = numeric(d, "pose_axes", 2)
         dims = axes.shape[1]
         if axes.shape[0] != 6 or not 1 <= dims <= 6:
@@ -283,7 +287,9 @@ class EigenGaitModel:
         rate_hz = float(numeric(d, "rate_hz", 0))
         if not 1.0 <= rate_hz <= 1000.0:
             raise NpzProblem(f"array 'rate_hz' must be a frame rate of 1..1000 Hz, got {rate_hz:g}")
-        sources = d.get("sources", np.array([], dtype=str))
+        if "sources" not in d:
+            raise NpzProblem("missing array 'sources'")
+        sources = d["sources"]
         if sources.dtype.kind not in "U" or sources.ndim != 1:
             raise NpzProblem("array 'sources' must be a list of file names (text)")
         residuals = d.get("pose_residuals_deg")
@@ -292,11 +298,20 @@ class EigenGaitModel:
             if residuals.shape not in ((0,), (6,)):
                 raise NpzProblem(f"array 'pose_residuals_deg' has shape {residuals.shape}, expected (6,)")
         variance_dims = whole("pose_variance_dims", 0, 6) if "pose_variance_dims" in d else 0
+        durations = shaped("durations_s", (n,))
+        if not np.all((durations >= 0.2) & (durations <= 10.0)):
+            raise NpzProblem("array 'durations_s' must hold cycle durations of 0.2..10 s")
+        labels = shaped("labels", (n,))
+        if not np.all((labels >= 0) & (labels <= 2.0)):
+            raise NpzProblem("array 'labels' must hold step lengths of 0..2 m")
+        phases = shaped("right_strike_phases", (n,))
+        if not np.all((phases > 0) & (phases < 1)):
+            raise NpzProblem("array 'right_strike_phases' must hold phases between 0 and 1")
         return cls(basis_kind, n_basis, samples, bool(numeric(d, "periodic", 0)), roughness,
                    shaped("pose_mean", (6,)), axes, shaped("pose_eigenvalues", (6,)),
                    shaped("coef_mean", (dims, n_basis)), eigen_coefs, shaped("eigenvalues", (m,)),
-                   whole("n_components", 1, m), scores, shaped("labels", (n,)), shaped("warp_coefs", (n, n_basis)),
-                   shaped("durations_s", (n,)), shaped("right_strike_phases", (n,)), whole("label_degree", 0, 10),
+                   whole("n_components", 1, m), scores, labels, shaped("warp_coefs", (n, n_basis)),
+                   durations, phases, whole("label_degree", 0, 10),
                    LegGeometry(*map(float, geometry)), rate_hz, tuple(str(x) for x in sources),
                    variance_dims, residuals)
 

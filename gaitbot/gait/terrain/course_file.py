@@ -73,6 +73,15 @@ _COURSE_KEYS = ("start_m", "end_m", "margin_m", "clearance_m", "max_step_m", "ma
 _TREAD_KEYS = ("start_m", "length_m", "height_m")
 
 
+def _tread(fields: Fields, t: dict, i: int) -> Tread:
+    try:
+        return Tread(fields.number(t, "start_m", f"tread[{i}]", within=POSITION_RANGE_M),
+                     fields.number(t, "length_m", f"tread[{i}]", positive=True, within=TREAD_LENGTH_RANGE_M),
+                     fields.number(t, "height_m", f"tread[{i}]", within=HEIGHT_RANGE_M))
+    except TerrainFileError as exc:
+        raise TerrainFileError(exc.path, exc.field, f"{exc.reason} (tread {i})") from None
+
+
 def load_course(path) -> Course:
     """Read and check a terrain file; raise TerrainFileError (one line) for the first problem."""
     path = Path(path)
@@ -104,10 +113,7 @@ def load_course(path) -> Course:
     tables = fields.tables(data, "tread", _TREAD_KEYS)
     if len(tables) > MAX_TREADS:
         raise fields.fail("tread", f"{len(tables)} treads, more than the {MAX_TREADS} a course may have")
-    treads = tuple(Tread(fields.number(t, "start_m", f"tread[{i}]", within=POSITION_RANGE_M),
-                         fields.number(t, "length_m", f"tread[{i}]", positive=True, within=TREAD_LENGTH_RANGE_M),
-                         fields.number(t, "height_m", f"tread[{i}]", within=HEIGHT_RANGE_M))
-                   for i, t in enumerate(tables, start=1))
+    treads = tuple(_tread(fields, t, i) for i, t in enumerate(tables, start=1))
     try:
         terrain = Terrain(treads)
     except TerrainError as exc:
