@@ -6,15 +6,27 @@ fails outside a walk session prints one line and exits with status 1 (a tracebac
 
 from __future__ import annotations
 
-import argparse
-import importlib
+import os
 import signal
 import sys
-import warnings
+import threading
 
-from gaitbot import __version__
-from gaitbot.errors import UserError
-from gaitbot.stream.signals import StopSignals, Terminated  # light: the rooms are imported by the commands
+#: Signals that came while the command line was still being imported (the command then ends at once,
+#: exit 130 or 143, nothing sent). Caught only when this module is the program being run, never when a
+#: script or a test imports it.
+EARLY_SIGNALS: list[int] = []
+if os.path.basename(sys.argv[0] if sys.argv else "") in ("gaitbot", "cli.py", "__main__.py") \
+        and threading.current_thread() is threading.main_thread():
+    for _signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(_signum, lambda signum, _frame: EARLY_SIGNALS.append(signum))
+
+import argparse  # noqa: E402 - after the early handlers: imports take a tenth of a second
+import importlib  # noqa: E402
+import warnings  # noqa: E402
+
+from gaitbot import __version__  # noqa: E402
+from gaitbot.errors import UserError  # noqa: E402
+from gaitbot.stream.signals import StopSignals, Terminated  # noqa: E402 - light: rooms come with the commands
 
 #: Subcommand -> the module of gaitbot.app whose ``run(args)`` does it (imported when used: ``plot``
 #: needs matplotlib, ``walk --sim`` MuJoCo, and the rest should not wait for them).
@@ -148,6 +160,13 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     signals = StopSignals()  # first: a Ctrl-C from here on is one line and exit 130, never a traceback
     signals.install()
+    if EARLY_SIGNALS:
+        signals.received, signals.first_signal = len(EARLY_SIGNALS), EARLY_SIGNALS[0]
+        signals.ignore_from_now()
+        terminated = EARLY_SIGNALS[0] == signal.SIGTERM
+        print(f"gaitbot: {'terminated (SIGTERM)' if terminated else 'interrupted (Ctrl-C)'} while starting; "
+              "nothing was sent", file=sys.stderr)
+        return 143 if terminated else 130
     try:
         return _main(argv, signals)
     except (KeyboardInterrupt, Terminated):  # while parsing or importing, before a command ran

@@ -146,6 +146,10 @@ def run_synth(args) -> int:
         raise UsageError("--pose-time: only with --pose-deg (the pose to pass through at that time)")
     if args.pose_time is not None and not math.isfinite(args.pose_time):
         raise UsageError(f"--pose-time must be a finite number of seconds, got {args.pose_time!r}")
+    for name in ("step_length", "to_step_length"):
+        value = getattr(args, name)
+        if value is not None and not (math.isfinite(value) and value >= 0):
+            raise UsageError(f"--{name.replace('_', '-')} must be a finite number of metres, 0 or more, got {value:g}")
     model = EigenGaitModel.load(args.model)
     config = load_robot(args.robot)
     if leg_geometry(config) != model.geometry:
@@ -155,10 +159,6 @@ def run_synth(args) -> int:
         value = getattr(args, name)
         if value is not None and not math.isfinite(value):
             raise UsageError(f"--{name.replace('_', '-')} must be a finite number of metres, got {value!r}")
-    for name in ("step_length", "to_step_length"):
-        value = getattr(args, name)
-        if value is not None and value < 0:
-            raise UsageError(f"--{name.replace('_', '-')} must be 0 or more metres, got {value:g}")
     if args.step_length > config.gait.max_step_m or (args.to_step_length or 0) > config.gait.max_step_m:
         raise UsageError(f"step lengths must be at most max_step_m = {config.gait.max_step_m:g} m ({config.name})")
     components = args.components

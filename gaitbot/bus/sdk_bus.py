@@ -47,6 +47,8 @@ READ_BACK_LENGTHS = 8
 STALE_REPLY_HORIZON_S = 1.0
 #: A read-back with less budget than this left in its frame is not sent (outcome "skipped").
 MIN_READ_BACK_BUDGET_S = 0.5e-3
+#: Before torque goes off after abandoned read-backs, the bus waits at most this long for the line to go quiet.
+QUIET_WAIT_S = 0.25
 #: An attempt of a blocking exchange whose status packet came during the late-reply watch.
 LATE_REPLY = "late"
 #: Linux pseudo-terminal slaves (Unix98 ptys) have device majors 136..143.
@@ -109,6 +111,7 @@ class SdkBus(Bus):
         self._abandoned: dict[int, list[tuple[int, float]]] = {}  # servo -> [(length asked, sent at)] unanswered
         self._late_seen: dict[int, float] = {}  # servo -> lateness of its latest reply to an abandoned read
         self._damaged_seen: dict[int, int] = {}  # servo -> damaged status packets seen since its last read-back
+        self.collected_bytes = 0  # bytes the last look at stale input found
         self.open_notes: list[str] = []  # how the port was opened, when that differs from the config
 
     # --- hooks for subclasses -------------------------------------------------------------
@@ -245,6 +248,8 @@ class SdkBus(Bus):
         bits are recorded in ``last_status_errors`` and not raised when disabling.
         """
         self._require_open()
+        if not enabled and self._abandoned_any():
+            self._wait_for_quiet()  # late replies still on their way would be taken for the servos' answers
         failures: list[BusError] = []
         for servo_id in ids:
             self._model(servo_id)
@@ -414,6 +419,20 @@ class SdkBus(Bus):
                 return ("damaged" if damaged else "missed"), None
             else:
                 time.sleep(0.0002)
+
+    def _wait_for_quiet(self, quiet_s: float = 0.03, at_most_s: float = QUIET_WAIT_S) -> None:
+        """Read (and note) whatever still arrives until the line has been quiet for ``quiet_s``, at most
+        ``at_most_s``: after read-backs were abandoned, their late replies are still coming."""
+        start = last = time.monotonic()
+        while True:
+            with self._port_guard():
+                self._collect_stale_input()
+            now = time.monotonic()
+            if self.collected_bytes:
+                last = now
+            if now - last >= quiet_s or now - start >= at_most_s:
+                return
+            time.sleep(0.001)
 
     def _abandoned_any(self) -> bool:
         return any(self._abandoned.values())
@@ -635,6 +654,7 @@ class SdkBus(Bus):
 
         Called before each goal write too: the SDK's txPacket clears the input buffer (Dynamixel's
         clearPort), and a late reply dropped unseen could not be told from a lost one."""
+        self.collected_bytes = 0
         available = getattr(self.port, "getBytesAvailable", None)
         if not callable(available):
             return b""
@@ -642,6 +662,7 @@ class SdkBus(Bus):
         if not pending:
             return b""
         stale = bytes(self.port.readPort(pending))
+        self.collected_bytes = len(stale)
         framing = wire.framing_for(self.family, self.protocol)
         unmatched = bytearray()
         for raw, is_packet in wire.split_complete(bytearray(stale), framing):

@@ -67,7 +67,7 @@ MARGIN_RANGE_M = (0.0, 0.1, "m")
 OPTIONAL_RANGES_M = {"clearance_m": (0.0, 0.5, "m"), "max_step_m": (0.005, 2.0, "m"), "max_rise_m": (0.001, 1.0, "m")}
 TREAD_LENGTH_RANGE_M = (0.005, 20.0, "m")
 HEIGHT_RANGE_M = (-1.0, 1.0, "m")
-MAX_TREADS = 1000
+MAX_TREADS = 100
 
 _COURSE_KEYS = ("start_m", "end_m", "margin_m", "clearance_m", "max_step_m", "max_rise_m")
 _TREAD_KEYS = ("start_m", "length_m", "height_m")
