@@ -15,8 +15,10 @@ import threading
 #: exit 130 or 143, nothing sent). Caught only when this module is the program being run, never when a
 #: script or a test imports it.
 EARLY_SIGNALS: list[int] = []
-if os.path.basename(sys.argv[0] if sys.argv else "") in ("gaitbot", "cli.py", "__main__.py") \
-        and threading.current_thread() is threading.main_thread():
+#: True when this module is the program being run (the console script, ``python -m gaitbot``).
+RUN_AS_PROGRAM = os.path.basename(sys.argv[0] if sys.argv else "") in ("gaitbot", "cli.py", "__main__.py") \
+    and threading.current_thread() is threading.main_thread()
+if RUN_AS_PROGRAM:
     for _signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(_signum, lambda signum, _frame: EARLY_SIGNALS.append(signum))
 
@@ -175,7 +177,7 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)
         return 143 if terminated else 130
     finally:
-        if signals.received:
+        if signals.received or RUN_AS_PROGRAM:  # the process is ending: a late signal must not become a traceback
             signals.ignore_from_now()
         else:
             signals.restore()

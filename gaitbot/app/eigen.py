@@ -27,6 +27,7 @@ from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, cyc
 from gaitbot.gait.trajectory import WALKING_JOINTS, Trajectory
 from gaitbot.app.options import UsageError, check_output_path, load_robot, write_output
 from gaitbot.check.preflight import preflight
+from gaitbot.errors import UserError
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 
 POSE_TOL_DEG = 0.1
@@ -189,8 +190,17 @@ def run_synth(args) -> int:
                                   f"{model.pose_dims} pose axes miss {WALKING_JOINTS[j]} by {worst:.3g} deg ({hint})")
         alphas = [alpha] * (args.cycles + 1)
         pose_report = (args.pose_time, worst)
-    walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,
-                           components=components, alphas=alphas)
+    try:
+        walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,
+                               components=components, alphas=alphas)
+        finite = all(np.all(np.isfinite(a)) for a in (walk.t_s, walk.angles_rad, walk.root_m))
+        if not finite:
+            raise ValueError("a value is not a finite number")
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        if isinstance(exc, UserError):
+            raise
+        raise UsageError(f"{args.model}: this model does not synthesise a walk of finite angles "
+                         f"({' '.join(str(exc).split())}); fit it again with `gaitbot eigen fit`") from None
     write_output(out, walk.save)
     xs = [h.x_m for h in walk.heel_strikes]
     print(f"wrote {out}: {len(walk)} frames, {walk.t_s[-1]:.2f} s, {len(xs)} heel strikes, "

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from gaitbot.app.options import UsageError, check_output_path, file_option, gait_source, write_output
+from gaitbot.errors import UserError
 from gaitbot.gait.eigen import is_model_file
 from gaitbot.gait.terrain.course_file import load_course
 from gaitbot.gait.trajectory import Trajectory
@@ -26,7 +27,12 @@ def run(args) -> int:
         raise UsageError(f"-o {out}: the picture's name must end in a format matplotlib writes "
                          f"({', '.join('.' + f for f in formats)})")
     if Path(args.file).suffix == ".npz" and is_model_file(args.file):
-        write_output(out, lambda path: plot_eigen_model(args.file, path))
+        try:
+            write_output(out, lambda path: plot_eigen_model(args.file, path))
+        except (ValueError, ArithmeticError) as exc:
+            if isinstance(exc, UserError):
+                raise
+            raise UsageError(f"{args.file}: this model cannot be drawn ({' '.join(str(exc).split())})") from None
         print(f"wrote {args.output}")
         return 0
     trajectory = Trajectory.load(args.file)
