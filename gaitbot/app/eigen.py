@@ -24,7 +24,7 @@ import numpy as np
 
 from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, cycles_from_trajectory, fit_model,
                                 synthesize_walk, walk_label)
-from gaitbot.gait.trajectory import WALKING_JOINTS, Trajectory
+from gaitbot.gait.trajectory import MAX_ANGLE_DEG, WALKING_JOINTS, Trajectory
 from gaitbot.app.options import UsageError, check_output_path, load_robot, write_output
 from gaitbot.check.preflight import preflight
 from gaitbot.errors import UserError
@@ -193,9 +193,11 @@ def run_synth(args) -> int:
     try:
         walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,
                                components=components, alphas=alphas)
-        finite = all(np.all(np.isfinite(a)) for a in (walk.t_s, walk.angles_rad, walk.root_m))
-        if not finite:
-            raise ValueError("a value is not a finite number")
+        with np.errstate(all="ignore"):
+            angles_deg = np.degrees(walk.angles_rad)
+            finite = all(np.all(np.isfinite(a)) for a in (walk.t_s, angles_deg, walk.root_m))
+        if not finite or np.abs(angles_deg).max() > MAX_ANGLE_DEG:
+            raise ValueError(f"an angle is not a finite number within +-{MAX_ANGLE_DEG:g} deg")
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, UserError):
             raise

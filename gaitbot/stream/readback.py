@@ -33,6 +33,11 @@ READ_BACK_SILENCE_S = 0.5
 #: that started late leaves its read too little time, and such a miss says more about the host than
 #: the servo (the next servo in turn is read then, so every servo keeps being read).
 FAIR_BUDGET_S = 4.0e-3
+#: When this many frames in a row started too late to leave their read any budget, the next read gets
+#: READ_BACK_FLOOR_S anyway: a stream that stays late (a very busy host) is still watched, and a servo
+#: reporting error bits still stops it; the cost is at most that much more lateness every few frames.
+SKIPPED_READS_BEFORE_FLOOR = 5
+READ_BACK_FLOOR_S = 2.0e-3
 #: The read-back's budget ends this long before the next frame's deadline: room for the clock's wake-up
 #: (the MonotonicClock spins its last 1.5 ms) so the next goals still go out on time.
 READ_BACK_MARGIN_S = 2.0e-3
@@ -65,6 +70,7 @@ class ReadBackMonitor:
         self.missed: dict[int, list[ReadBack]] = {}  # servo -> its misses in a row
         self.reads = 0
         self.skipped = 0
+        self.skipped_in_row = 0
 
     def budget_s(self, deadline_s: float) -> float:
         return deadline_s + self.period_s - self.margin_s - self.clock.now()
@@ -75,12 +81,16 @@ class ReadBackMonitor:
         else:
             servo_id = self.ids[self.next_index % len(self.ids)]
         budget_s = self.budget_s(deadline_s)
+        if self.skipped_in_row >= SKIPPED_READS_BEFORE_FLOOR:
+            budget_s = max(budget_s, READ_BACK_FLOOR_S)
         asked_s = self.clock.now()
         result = self.bus.read_back(servo_id, budget_s)
         self.reads += 1
         if result.outcome == "skipped":
             self.skipped += 1
+            self.skipped_in_row += 1
             return
+        self.skipped_in_row = 0
         if result.outcome == "answered":
             self.missed.pop(servo_id, None)
             self.first_miss_s.pop(servo_id, None)

@@ -237,3 +237,26 @@ def test_misses_in_frames_that_started_late_name_no_one_and_every_servo_is_still
         monitor(deadline)
     assert set(bus.reads) == {1, 2, 3, 4, 5, 6}
     assert max(bus.reads.count(i) for i in range(1, 7)) - min(bus.reads.count(i) for i in range(1, 7)) <= 1
+
+
+def test_a_stream_that_stays_late_is_still_read_back():
+    """Frames that all start a period late leave no budget; every few frames a read goes out anyway."""
+    clock = VirtualClock()
+
+    class Budgets(ScriptedBus):
+        budgets: list[float] = []
+
+        def read_back(self, servo_id, budget_s):
+            self.budgets.append(budget_s)
+            if budget_s < 0.5e-3:
+                return ReadBack(servo_id, "skipped")
+            return super().read_back(servo_id, budget_s)
+
+    bus = Budgets(clock)
+    monitor = ReadBackMonitor(bus, [1, 2, 3], clock, 1 / 60)
+    for k in range(60):
+        clock.sleep_until(k / 60 + 0.02)  # every frame 20 ms late: nothing left of its period
+        monitor(k / 60)
+    sent = [b for b in bus.budgets if b >= 0.5e-3]
+    assert 8 <= len(sent) <= 12  # one read in every six frames
+    assert set(bus.reads) == {1, 2, 3}
