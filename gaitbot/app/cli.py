@@ -212,6 +212,12 @@ def _main(argv: list[str] | None, signals: StopSignals) -> int:
             raise
         print(f"gaitbot {args.command}: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return exc.exit_status
+    except BrokenPipeError:  # the reader of our output went away (``| head``): nothing more to say to anyone
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except OSError:
+            pass
+        return 1
     except OSError as exc:  # a file named on the command line that the OS refuses (a name too long, a loop ...)
         if args.debug:
             raise
