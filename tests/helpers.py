@@ -7,14 +7,23 @@ simulated robot floated in the air.
 """
 from __future__ import annotations
 
+import io
 import json
+import os
+import re
+import resource
+import signal
 import subprocess
 import sys
+import tempfile
+import time
+import traceback
 from pathlib import Path
 
 import numpy as np
 
 from gaitbot.app.cli import main
+from gaitbot.errors import UserError
 from gaitbot.robot.config import load_robot_config, resolve_config
 from gaitbot.servos import wire
 
@@ -190,3 +199,117 @@ def float_in_air(robot) -> None:
     robot.model.opt.gravity[:] = 0.0
     robot.data.qpos[robot.model.joint("boom_z").qposadr[0]] = 0.5
     robot.mujoco.mj_forward(robot.model, robot.data)
+
+
+# --- bounded runs of hostile input (tests/test_hostile_input.py, tests/app/test_hostile_cases.py)
+
+TIME_BOUND_S = 20.0
+MEMORY_HEADROOM = 1536 * 2**20  # bytes of address space a child may add to what the test process has mapped
+PY_WARNING = re.compile(r"\w*Warning\b")
+
+
+def _child(fn, args, write_fd: int, capture: bool) -> None:
+    result: dict
+    try:
+        with open("/proc/self/status") as f:
+            vm = next(int(line.split()[1]) * 1024 for line in f if line.startswith("VmSize:"))
+        resource.setrlimit(resource.RLIMIT_AS, (vm + MEMORY_HEADROOM, vm + MEMORY_HEADROOM))
+        resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+        if capture:
+            out, err = tempfile.TemporaryFile(), tempfile.TemporaryFile()
+            os.dup2(out.fileno(), 1)
+            os.dup2(err.fileno(), 2)
+            sys.stdout = io.TextIOWrapper(os.fdopen(os.dup(1), "wb"), encoding="utf-8", line_buffering=True)
+            sys.stderr = io.TextIOWrapper(os.fdopen(os.dup(2), "wb"), encoding="utf-8", line_buffering=True)
+        start = time.monotonic()
+        try:
+            value = fn(*args)
+            result = {"outcome": "ok", "value": value if isinstance(value, (int, type(None))) else None}
+        except SystemExit as exc:
+            result = {"outcome": "ok", "value": exc.code if isinstance(exc.code, int) else 1}
+        except BaseException as exc:  # noqa: BLE001 - everything is reported
+            result = {"outcome": "raised", "type": type(exc).__name__, "user_error": isinstance(exc, UserError),
+                      "message": str(exc)[:2000], "traceback": traceback.format_exc()[-2000:]}
+        result["elapsed_s"] = time.monotonic() - start
+        if capture:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            out.seek(0)
+            err.seek(0)
+            result["stdout"] = out.read().decode("utf-8", "replace")[-50000:]
+            result["stderr"] = err.read().decode("utf-8", "replace")[-50000:]
+    except BaseException as exc:  # noqa: BLE001
+        result = {"outcome": "raised", "type": type(exc).__name__, "user_error": False, "message": f"(harness) {exc}"}
+    with os.fdopen(write_fd, "wb") as pipe:
+        pipe.write(json.dumps(result, default=str).encode())
+    os._exit(0)
+
+
+def isolated(fn, *args, capture: bool = False, bound_s: float = TIME_BOUND_S) -> dict:
+    """``fn(*args)`` in a forked child with a memory limit and a time bound: what happened, as a dict."""
+    read_fd, write_fd = os.pipe()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:
+        os.close(read_fd)
+        try:
+            _child(fn, args, write_fd, capture)
+        finally:
+            os._exit(70)
+    os.close(write_fd)
+    os.set_blocking(read_fd, False)
+    chunks, start = [], time.monotonic()
+    while True:
+        try:
+            chunk = os.read(read_fd, 1 << 16)
+            if chunk:
+                chunks.append(chunk)
+        except BlockingIOError:
+            pass
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            break
+        if time.monotonic() - start > bound_s:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            os.close(read_fd)
+            return {"outcome": "timeout", "elapsed_s": time.monotonic() - start}
+        time.sleep(0.002)
+    try:
+        while chunk := os.read(read_fd, 1 << 16):
+            chunks.append(chunk)
+    except BlockingIOError:
+        pass
+    os.close(read_fd)
+    if not chunks:
+        return {"outcome": "crash", "status": status}
+    return json.loads(b"".join(chunks))
+
+
+def assert_reader_behaves(result: dict, path: Path) -> None:
+    """Accepted, or one UserError naming the file; nothing else, within the bounds."""
+    assert result["outcome"] in ("ok", "raised"), result
+    if result["outcome"] == "raised":
+        assert result["user_error"], f"{result['type']}: {result['message']}\n{result.get('traceback', '')}"
+        assert path.name in result["message"], result["message"]
+        assert "\n" not in result["message"].strip() or result["type"] == "ConfigError", result["message"]
+
+
+def assert_cli_behaves(result: dict, allowed=(0, 2)) -> None:
+    """Exit 0/2 (or as allowed), never a traceback or a warning, and an error is one line."""
+    assert result["outcome"] == "ok", result
+    code, err = result["value"], result["stderr"]
+    assert "Traceback" not in err, err
+    assert not PY_WARNING.search(err), err
+    assert code in allowed, (code, err, result["stdout"][-500:])
+    if code == 2:
+        lines = [line for line in err.splitlines() if line.strip()]
+        assert len(lines) == 1 and lines[0].startswith("gaitbot"), err
+        assert not result["stdout"].strip(), result["stdout"]
+
+
+def cli(*argv: str) -> dict:
+    return isolated(main, [str(a) for a in argv], capture=True)
+
+

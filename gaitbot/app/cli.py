@@ -6,14 +6,30 @@ fails outside a walk session prints one line and exits with status 1 (a tracebac
 
 from __future__ import annotations
 
-import argparse
-import importlib
+import os
+import signal
 import sys
 import textwrap
+import threading
 
-from gaitbot import __version__
-from gaitbot.bus.base import BusError
-from gaitbot.errors import UserError
+#: Signals that came while the command line was still being imported (the command then ends at once,
+#: exit 130 or 143, nothing sent). Caught only when this module is the program being run, never when a
+#: script or a test imports it.
+EARLY_SIGNALS: list[int] = []
+#: True when this module is the program being run (the console script, ``python -m gaitbot``).
+RUN_AS_PROGRAM = os.path.basename(sys.argv[0] if sys.argv else "") in ("gaitbot", "cli.py", "__main__.py") \
+    and threading.current_thread() is threading.main_thread()
+if RUN_AS_PROGRAM:
+    for _signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(_signum, lambda signum, _frame: EARLY_SIGNALS.append(signum))
+
+import argparse  # noqa: E402 - after the early handlers: imports take a tenth of a second
+import importlib  # noqa: E402
+import warnings  # noqa: E402
+
+from gaitbot import __version__  # noqa: E402
+from gaitbot.errors import UserError  # noqa: E402
+from gaitbot.stream.signals import StopSignals, Terminated  # noqa: E402 - light: rooms come with the commands
 
 #: Subcommand -> the module of gaitbot.app whose ``run(args)`` does it (imported when used: ``plot``
 #: needs matplotlib, ``walk --sim`` MuJoCo, and the rest should not wait for them).
@@ -54,8 +70,16 @@ def _walk_inputs(p: argparse.ArgumentParser) -> None:
                    "--steps/--distance")
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line (the program, the error, where to look) and exit 2: no usage
+    block around it (``--help`` still prints the usage)."""
+
+    def error(self, message: str):  # noqa: D401 - argparse's name
+        self.exit(2, f"{self.prog}: error: {' '.join(message.split())} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="gaitbot", description="Walking gaits for small servo bipeds.")
+    parser = OneLineParser(prog="gaitbot", description="Walking gaits for small servo bipeds.")
     parser.add_argument("--version", action="version", version=f"gaitbot {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -207,6 +231,30 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    signals = StopSignals()  # first: a Ctrl-C from here on is one line and exit 130, never a traceback
+    signals.install()
+    if EARLY_SIGNALS:
+        signals.received, signals.first_signal = len(EARLY_SIGNALS), EARLY_SIGNALS[0]
+        signals.ignore_from_now()
+        terminated = EARLY_SIGNALS[0] == signal.SIGTERM
+        print(f"gaitbot: {'terminated (SIGTERM)' if terminated else 'interrupted (Ctrl-C)'} while starting; "
+              "nothing was sent", file=sys.stderr)
+        return 143 if terminated else 130
+    try:
+        return _main(argv, signals)
+    except (KeyboardInterrupt, Terminated):  # while parsing or importing, before a command ran
+        terminated = signals.first_signal == signal.SIGTERM
+        print(f"gaitbot: {'terminated (SIGTERM)' if terminated else 'interrupted (Ctrl-C)'}; nothing was sent",
+              file=sys.stderr)
+        return 143 if terminated else 130
+    finally:
+        if signals.received or RUN_AS_PROGRAM:  # the process is ending: a late signal must not become a traceback
+            signals.ignore_from_now()
+        else:
+            signals.restore()
+
+
+def _main(argv: list[str] | None, signals: StopSignals) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     sources = [name for name in ("steps", "distance", "terrain", "trajectory") if getattr(args, name, None) is not None]
@@ -217,13 +265,37 @@ def main(argv: list[str] | None = None) -> int:
             args.distance = 0.5  # the built-in demo: half a metre on the mock bus or the simulated robot
         else:
             parser.error(f"{args.command}: give --steps or --distance")
+    if not args.debug:  # an error is one line: no RuntimeWarning or library warning around it (--debug shows them)
+        warnings.simplefilter("ignore")
+    from gaitbot.bus.base import BusError  # imported here: the bus room brings the vendor SDKs and numpy
+
     try:
         return importlib.import_module(COMMANDS[args.command]).run(args)
+    except (KeyboardInterrupt, Terminated):  # before or after a session (a session handles its own)
+        if args.debug:
+            raise
+        terminated = signals.first_signal == signal.SIGTERM
+        print(f"gaitbot {args.command}: {'terminated (SIGTERM)' if terminated else 'interrupted (Ctrl-C)'}; "
+              "nothing more was sent", file=sys.stderr)
+        return 143 if terminated else 130
     except UserError as exc:
         if args.debug:
             raise
         print(f"gaitbot {args.command}: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return exc.exit_status
+    except BrokenPipeError:  # the reader of our output went away (``| head``): nothing more to say to anyone
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except OSError:
+            pass
+        return 1
+    except OSError as exc:  # a file named on the command line that the OS refuses (a name too long, a loop ...)
+        if args.debug:
+            raise
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"gaitbot {args.command}: error: {' '.join((where + (exc.strerror or str(exc))).split())}",
+              file=sys.stderr)
+        return 2
     except BusError as exc:  # a bus that fails outside a walk session (scan): one line, status 1
         if args.debug:
             raise

@@ -25,12 +25,15 @@ import numpy as np
 from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, cycles_from_trajectory, fit_model,
                                 synthesize_walk, walk_label)
 from gaitbot.gait.joints import PITCH_JOINTS
-from gaitbot.gait.trajectory import Trajectory
-from gaitbot.app.options import UsageError, load_robot
+from gaitbot.gait.trajectory import MAX_ANGLE_DEG, Trajectory
+from gaitbot.app.options import UsageError, check_output_path, load_robot, write_output
 from gaitbot.check.preflight import preflight
+from gaitbot.errors import UserError
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 
 POSE_TOL_DEG = 0.1
+#: Synthesised cycles one `eigen synth` may ask for (each two steps).
+MAX_CYCLES = 500
 
 
 def run(args) -> int:
@@ -69,6 +72,7 @@ def run_fit(args) -> int:
     out = Path(args.output)
     if out.suffix != ".npz":
         raise UsageError(f"-o {out}: the model file must end in .npz")
+    check_output_path(out)
     config = load_robot(args.robot, getattr(args, "calibration", None))
     geometry = leg_geometry(config)
     options = FitOptions(samples=args.samples, basis=args.basis, n_basis=args.n_basis, roughness=args.roughness,
@@ -77,7 +81,7 @@ def run_fit(args) -> int:
                          label_degree=args.label_degree)
     examples, rate = load_examples(args.examples, geometry, config.gait.rate_hz, config)
     model = fit_model(examples, geometry, rate, options, periodic=args.basis == "fourier")
-    model.save(out)
+    write_output(out, model.save)
     labels = sorted(set(np.round(model.labels, 6)))
     print(f"wrote {out}: {len(examples)} example cycles from {len(args.examples)} files, step lengths "
           f"{', '.join(f'{v:g}' for v in labels)} m")
@@ -137,6 +141,17 @@ def run_synth(args) -> int:
     out = Path(args.output)
     if out.suffix not in (".csv", ".npz"):
         raise UsageError(f"-o {out}: the output must end in .csv or .npz")
+    check_output_path(out)
+    if not 1 <= args.cycles <= MAX_CYCLES:
+        raise UsageError(f"--cycles must be 1..{MAX_CYCLES}, got {args.cycles}")
+    if args.pose_time is not None and args.pose_deg is None:
+        raise UsageError("--pose-time: only with --pose-deg (the pose to pass through at that time)")
+    if args.pose_time is not None and not math.isfinite(args.pose_time):
+        raise UsageError(f"--pose-time must be a finite number of seconds, got {args.pose_time!r}")
+    for name in ("step_length", "to_step_length"):
+        value = getattr(args, name)
+        if value is not None and not (math.isfinite(value) and value >= 0):
+            raise UsageError(f"--{name.replace('_', '-')} must be a finite number of metres, 0 or more, got {value:g}")
     model = EigenGaitModel.load(args.model)
     config = load_robot(args.robot, getattr(args, "calibration", None))
     if leg_geometry(config) != model.geometry:
@@ -176,9 +191,20 @@ def run_synth(args) -> int:
                                   f"{model.pose_dims} pose axes miss {PITCH_JOINTS[j]} by {worst:.3g} deg ({hint})")
         alphas = [alpha] * (args.cycles + 1)
         pose_report = (args.pose_time, worst)
-    walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,
-                           components=components, alphas=alphas)
-    walk.save(out)
+    try:
+        walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,
+                               components=components, alphas=alphas)
+        with np.errstate(all="ignore"):
+            angles_deg = np.degrees(walk.angles_rad)
+            finite = all(np.all(np.isfinite(a)) for a in (walk.t_s, angles_deg, walk.root_m))
+        if not finite or np.abs(angles_deg).max() > MAX_ANGLE_DEG:
+            raise ValueError(f"an angle is not a finite number within +-{MAX_ANGLE_DEG:g} deg")
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        if isinstance(exc, UserError):
+            raise
+        raise UsageError(f"{args.model}: this model does not synthesise a walk of finite angles "
+                         f"({' '.join(str(exc).split())}); fit it again with `gaitbot eigen fit`") from None
+    write_output(out, walk.save)
     xs = [h.x_m for h in walk.heel_strikes]
     print(f"wrote {out}: {len(walk)} frames, {walk.t_s[-1]:.2f} s, {len(xs)} heel strikes, "
           f"{walk.root_m[-1, 0] - walk.root_m[0, 0]:.4f} m; step lengths {', '.join(f'{d:.4f}' for d in np.diff(xs))} m")

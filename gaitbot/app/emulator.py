@@ -18,8 +18,10 @@ every option.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
+from gaitbot.app.cli import OneLineParser
 from gaitbot.bus.emulator import (FAULT_KINDS, EmulatorConfig, Faults, Heat, ServoEmulator, hand_from_ticks,
                                   hand_from_trajectory)
 from gaitbot.robot.calibration_file import load_robot_with_calibration
@@ -48,9 +50,37 @@ def parse_ids(text: str) -> list[int]:
 
 def _id_value(text: str, what: str) -> tuple[int, str]:
     servo_id, sep, value = text.partition(":")
-    if not sep:
-        raise ValueError(f"{what} {text!r}: expected ID:VALUE")
+    if not sep or not servo_id.strip().isdigit():
+        raise ValueError(f"{what} {text!r}: expected ID:VALUE with a servo id, e.g. 3:{value or '60'}")
     return int(servo_id), value
+
+
+def check_fault_ids(faults: Faults, models) -> None:
+    """Every servo a fault names must be on the chain: a fault on a servo that is not there would be a test
+    that tests nothing."""
+    named = {"--silent": faults.silent, "--late": set(faults.late_s), "--error": set(faults.errors),
+             "--corrupt": faults.corrupt_ids or set()}
+    for flag, ids in named.items():
+        absent = sorted(i for i in ids if i not in models)
+        if absent:
+            raise ValueError(f"{flag}: servo {', '.join(map(str, absent))} is not on the chain "
+                             f"(ids {', '.join(map(str, sorted(models)))})")
+
+
+def check_numbers(args: argparse.Namespace) -> None:
+    """Counts and times that cannot be negative (or not finite), and rates that must be positive."""
+    for flag in ("fault_after_frames", "close_after_frames"):
+        value = getattr(args, flag)
+        if value is not None and value < 0:
+            raise ValueError(f"--{flag.replace('_', '-')} must be 0 or more goal frames, got {value}")
+    for flag in ("fault_after_s", "close_after_s", "return_delay_us"):
+        value = getattr(args, flag)
+        if value is not None and not (math.isfinite(value) and 0 <= value <= 1e6):
+            raise ValueError(f"--{flag.replace('_', '-')} must be a number within 0..1e6, got {value!r}")
+    if args.baudrate is not None and not 0 < args.baudrate <= 100_000_000:
+        raise ValueError(f"--baudrate must be a positive bit rate, got {args.baudrate}")
+    if args.hand_rate is not None and not (math.isfinite(args.hand_rate) and 0 < args.hand_rate <= 1000):
+        raise ValueError(f"--hand-rate must be within 0..1000 Hz, got {args.hand_rate!r}")
 
 
 def _id_numbers(items, flag: str, low: float, high: float, unit: str) -> dict[int, float]:
@@ -65,6 +95,7 @@ def _id_numbers(items, flag: str, low: float, high: float, unit: str) -> dict[in
 
 
 def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
+    check_numbers(args)
     config = _chain_from_args(args)
     config.heat = Heat(args.ambient, args.heat_rate, args.cool_time)
     if not (args.heat_rate >= 0 and args.cool_time > 0):
@@ -95,11 +126,20 @@ def _chain_from_args(args: argparse.Namespace) -> EmulatorConfig:
     faults.silent = set(args.silent or [])
     for item in args.late or []:
         servo_id, value = _id_value(item, "--late")
-        faults.late_s[servo_id] = float(value) / 1000.0
+        try:
+            late_ms = float(value)
+        except ValueError:
+            raise ValueError(f"--late {item!r}: MS must be a number of milliseconds") from None
+        if not (math.isfinite(late_ms) and 0 <= late_ms <= 10_000):
+            raise ValueError(f"--late {item!r}: MS must be within 0..10000 ms")
+        faults.late_s[servo_id] = late_ms / 1000.0
     if args.corrupt:
         fraction, _, which = args.corrupt.partition(":")
-        faults.corrupt_fraction = float(fraction)
-        faults.corrupt_ids = {int(which)} if which else None
+        try:
+            faults.corrupt_fraction = float(fraction)
+            faults.corrupt_ids = {int(which)} if which else None
+        except ValueError:
+            raise ValueError(f"--corrupt {args.corrupt!r}: expected FRACTION[:ID], e.g. 0.5:3") from None
         if not 0.0 <= faults.corrupt_fraction <= 1.0:
             raise ValueError(f"--corrupt {args.corrupt!r}: the fraction must be within 0..1")
     for item in args.error or []:
@@ -113,6 +153,7 @@ def _chain_from_args(args: argparse.Namespace) -> EmulatorConfig:
     hand = hand_from_ticks(args.hand_ticks, args.hand_rate) if args.hand_ticks else None
     if args.robot:
         robot = load_robot_with_calibration(args.robot, args.calibration)
+        check_fault_ids(faults, robot.models_by_id)
         if args.hand:
             hand = hand_from_trajectory(robot, args.hand, args.hand_rate)
         fresh = tuple(j.model for j in robot.joints)[:args.factory_fresh or None] \
@@ -137,12 +178,13 @@ def _chain_from_args(args: argparse.Namespace) -> EmulatorConfig:
         return EmulatorConfig(backend, protocol, {}, args.baudrate or 1_000_000, faults, args.log, seed=args.seed,
                               return_delay_us=args.return_delay_us, hand=hand, fresh=(model,) * args.factory_fresh)
     models = {i: model for i in parse_ids(args.ids)}
+    check_fault_ids(faults, models)
     return EmulatorConfig(backend, protocol, models, args.baudrate or 1_000_000, faults, args.log,
                           seed=args.seed, return_delay_us=args.return_delay_us, hand=hand)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(description="Emulate a Dynamixel/Feetech servo chain on a pty "
+    p = OneLineParser(prog="servo_emulator", description="Emulate a Dynamixel/Feetech servo chain on a pty "
                                             "(the first line printed is the device path).")
     p.add_argument("--robot", help="robot config (.toml path or shipped name): its bus and servos")
     p.add_argument("--protocol", choices=sorted(PROTOCOLS), help="without --robot: the chain's protocol")

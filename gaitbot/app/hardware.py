@@ -6,6 +6,7 @@ used by walk, record and scan).
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -15,10 +16,28 @@ from gaitbot.robot.config import RobotConfig
 
 
 def require_port(port: str) -> None:
-    """A real run needs a serial device that exists: say which one is missing and how to list them."""
+    """A real run needs a serial device that exists and is a terminal (a USB adapter, a pty): say which one is
+    missing, or what it is instead (/dev/null, a regular file, a folder), and how to list them, before anything
+    else is done."""
+    hint = "list them with: python -m serial.tools.list_ports -v; or try --dry-run"
+    if not port or not port.strip():
+        raise UsageError(f"--port: empty name ({hint})")
     if not Path(port).exists():
-        raise UsageError(f"--port {port}: no such serial port (list them with: python -m serial.tools.list_ports -v; "
-                         f"or try --dry-run)")
+        raise UsageError(f"--port {port}: no such serial port ({hint})")
+    if os.name != "posix":
+        return
+    if Path(port).is_dir():
+        raise UsageError(f"--port {port}: is a directory, not a serial port ({hint})")
+    try:
+        fd = os.open(port, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+    except OSError as exc:
+        raise UsageError(f"--port {port}: cannot open ({exc.strerror or exc}; {hint})") from None
+    try:
+        is_terminal = os.isatty(fd)
+    finally:
+        os.close(fd)
+    if not is_terminal:
+        raise UsageError(f"--port {port}: not a serial port (not a terminal device) ({hint})")
 
 
 def serial_port(config: RobotConfig, port: str | None, dry_run: bool) -> str:

@@ -8,6 +8,8 @@ once, the leg and walk settings (``gait_source``) and the step list. Errors for 
 from __future__ import annotations
 
 import math
+import os
+from pathlib import Path
 
 from gaitbot.bus.budget import bus_budget_check, check_robot_rate
 from gaitbot.errors import UserError
@@ -15,7 +17,7 @@ from gaitbot.gait.geometry import LegGeometry
 from gaitbot.gait.planning import perturb_steps, steps_for_distance
 from gaitbot.gait.walker import WalkSettings, make_context
 from gaitbot.robot.calibration_file import load_robot_with_calibration
-from gaitbot.robot.config import ConfigError, RobotConfig
+from gaitbot.robot.config import RATE_RANGE_HZ, ConfigError, RobotConfig
 from gaitbot.robot.walk_settings import GaitSource, leg_geometry, walk_settings
 
 
@@ -28,12 +30,44 @@ def load_robot(robot: str | None, calibration: str | None = None) -> RobotConfig
     calibration applied (``--calibration FILE``, else ``<config>.calibration.toml`` beside it if there is
     one: gaitbot.robot.calibration_file); a ``gait.rate_hz`` the bus cannot carry is refused at load
     (gaitbot.bus.budget)."""
+    if robot is not None and not robot.strip():
+        raise UsageError("--robot: empty name; give a .toml path or a shipped robot name (leave --robot out for "
+                         "the default robot)")
+    if calibration is not None and not calibration.strip():
+        raise UsageError("--calibration: empty file name")
     try:
         return load_robot_with_calibration(robot, calibration, extra_checks=[bus_budget_check])
     except (ConfigError, UserError):
         raise
     except (OSError, ValueError, KeyError) as exc:
         raise UsageError(f"--robot {robot}: {exc}") from None
+
+
+def file_option(value: str, flag: str) -> str:
+    """A file named on the command line: an empty name is refused (it would be read as the current folder)."""
+    if value is None or not str(value).strip():
+        raise UsageError(f"{flag}: empty file name")
+    return value
+
+
+def check_output_path(out: Path, flag: str = "-o") -> None:
+    """An output file that can be written before any work is done: not a directory, in a folder that exists
+    and is writable (a device such as /dev/full is only found out when written: see ``write_output``)."""
+    if out.is_dir():
+        raise UsageError(f"{flag} {out}: is a directory")
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir():
+        raise UsageError(f"{flag} {out}: cannot write there (no such directory {parent})")
+    if not os.access(parent, os.W_OK) or (out.exists() and not os.access(out, os.W_OK)):
+        raise UsageError(f"{flag} {out}: cannot write there (no permission)")
+
+
+def write_output(out: Path, write, flag: str = "-o") -> None:
+    """``write(out)``, with a failure to write (a full disk, /dev/full, a vanished folder) as one line, exit 2."""
+    try:
+        write(out)
+    except OSError as exc:
+        raise UsageError(f"{flag} {out}: cannot write ({exc.strerror or exc})") from None
 
 
 def positive_option(value: float | None, flag: str, what: str) -> None:
@@ -45,6 +79,8 @@ def positive_option(value: float | None, flag: str, what: str) -> None:
 def check_reply_timeout(reply_timeout_ms: float | None) -> None:
     """``--reply-timeout-ms``: how long to wait for each status packet, if given."""
     positive_option(reply_timeout_ms, "--reply-timeout-ms", "a positive number of milliseconds")
+    if reply_timeout_ms is not None and reply_timeout_ms > MAX_REPLY_TIMEOUT_MS:
+        raise UsageError(f"--reply-timeout-ms must be at most {MAX_REPLY_TIMEOUT_MS:g} ms, got {reply_timeout_ms:g}")
 
 
 def check_rate_option(config: RobotConfig, rate_hz: float | None, label: str | None = None) -> None:
@@ -52,11 +88,19 @@ def check_rate_option(config: RobotConfig, rate_hz: float | None, label: str | N
     robot's bus carries with its read-back."""
     if rate_hz is None:
         return
-    positive_option(rate_hz, "--rate", "a positive frame rate in Hz")
+    check_rate_range(rate_hz, label or "--rate")
     try:
         check_robot_rate(config, rate_hz)
     except ValueError as exc:
         raise UsageError(f"{label or f'--rate {rate_hz:g}'}: {exc}") from None
+
+
+def check_rate_range(rate_hz: float, label: str = "--rate") -> None:
+    """A frame rate within RATE_RANGE_HZ (10..200 Hz): slower, each goal is a jump a position servo makes at full
+    speed; faster, no read-back fits in a frame."""
+    low, high, _ = RATE_RANGE_HZ
+    if not (math.isfinite(rate_hz) and low <= rate_hz <= high):
+        raise UsageError(f"{label} must be a frame rate within {low:g}..{high:g} Hz, got {rate_hz:g}")
 
 
 def gait_source(args) -> GaitSource:
@@ -75,7 +119,8 @@ def gait_source(args) -> GaitSource:
     else:
         robot_for_limits = robot
     rate = getattr(args, "rate", None)
-    positive_option(rate, "--rate", "a positive frame rate in Hz")
+    if rate is not None:
+        check_rate_range(rate)
     settings = walk_settings(robot, rate)
     clearance = getattr(args, "clearance", None)
     if clearance is not None:
@@ -87,12 +132,25 @@ def gait_source(args) -> GaitSource:
     return GaitSource(geometry, settings, min(max_step, reachable), robot_for_limits)
 
 
+#: The most steps one walk may have (planning costs about 5 ms a step), and the longest --distance.
+MAX_STEPS = 1000
+MAX_DISTANCE_M = 100.0
+#: --seed must fit numpy's seeding (an unsigned 32-bit integer here).
+MAX_SEED = 2**32 - 1
+#: The longest wait for one status packet --reply-timeout-ms may set (start-up exchanges; a frame's
+#: read-back is bounded by its frame anyway).
+MAX_REPLY_TIMEOUT_MS = 1000.0
+
+
 def parse_step_list(text: str) -> list[float]:
     """``0.3,0.4,...`` -> floats; one clear error for anything else."""
     if text is None or not text.strip():
         raise UsageError("--steps: empty list; give step lengths in metres, e.g. --steps 0.05,0.06,0.05")
+    items = text.split(",")
+    if len(items) > MAX_STEPS:
+        raise UsageError(f"--steps: {len(items)} steps, more than the {MAX_STEPS} one walk may have")
     values = []
-    for i, item in enumerate(text.split(","), start=1):
+    for i, item in enumerate(items, start=1):
         try:
             value = float(item)
         except ValueError:
@@ -111,12 +169,18 @@ def step_lengths(args, source: GaitSource) -> list[float]:
         distance = args.distance
         if distance is None or not math.isfinite(distance) or distance <= 0:
             raise UsageError(f"--distance must be a positive number of metres, got {distance!r}")
+        if distance > MAX_DISTANCE_M:
+            raise UsageError(f"--distance {distance:g} m is longer than one walk may be (at most {MAX_DISTANCE_M:g} m)")
         max_step = source.max_step_m if args.max_step is None else args.max_step
         if not math.isfinite(max_step) or max_step <= 0:
             raise UsageError(f"--max-step must be a positive number of metres, got {max_step!r}")
         if max_step > source.max_step_m * (1 + 1e-12):
             raise UsageError(f"--max-step {max_step:g} m is longer than this robot's longest step "
                              f"{source.max_step_m:.4g} m")
+        if distance / max_step > MAX_STEPS:
+            flag = "--max-step" if args.max_step is not None else "--distance"
+            raise UsageError(f"{flag}: --distance {distance:g} m in steps of at most {max_step:g} m needs "
+                             f"{math.ceil(distance / max_step)} steps, more than the {MAX_STEPS} one walk may have")
         steps = steps_for_distance(distance, max_step)
     for i, value in enumerate(steps, start=1):
         if value < 0:
@@ -125,6 +189,11 @@ def step_lengths(args, source: GaitSource) -> list[float]:
             what = "max_step_m in the robot config" if source.robot is not None else "the leg's reachable maximum"
             raise UsageError(f"--steps: step {i} is {value:g} m, longer than {source.max_step_m:.4g} m ({what})")
     sigma = getattr(args, "perturb", None)
+    if sigma is not None and not (math.isfinite(sigma) and 0 <= sigma <= source.max_step_m):
+        raise UsageError(f"--perturb must be 0..{source.max_step_m:.4g} m (the longest step), got {sigma!r}")
+    seed = getattr(args, "seed", None)
+    if seed is not None and not 0 <= seed <= MAX_SEED:
+        raise UsageError(f"--seed must be 0..{MAX_SEED}, got {seed}")
     if sigma:
         steps = perturb_steps(steps, sigma, getattr(args, "seed", None), source.max_step_m)
     return steps

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gaitbot.app.options import UsageError, gait_source
+from gaitbot.app.options import UsageError, check_output_path, file_option, gait_source, write_output
+from gaitbot.errors import UserError
 from gaitbot.gait.eigen import is_model_file
 from gaitbot.gait.terrain.course_file import load_course
 from gaitbot.gait.trajectory import Trajectory
@@ -17,23 +18,35 @@ def run(args) -> int:
         raise UsageError("plotting needs matplotlib: pip install 'gaitbot[plot]'") from None
     from gaitbot.plot import plot_eigen_model, plot_trajectory
 
+    out = Path(args.output)
+    check_output_path(out)
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    formats = sorted(FigureCanvasBase.get_supported_filetypes())
+    if out.suffix.lower().lstrip(".") not in formats:
+        raise UsageError(f"-o {out}: the picture's name must end in a format matplotlib writes "
+                         f"({', '.join('.' + f for f in formats)})")
     if Path(args.file).suffix == ".npz" and is_model_file(args.file):
-        plot_eigen_model(args.file, Path(args.output))
+        try:
+            write_output(out, lambda path: plot_eigen_model(args.file, path))
+        except (ValueError, ArithmeticError) as exc:
+            if isinstance(exc, UserError):
+                raise
+            raise UsageError(f"{args.file}: this model cannot be drawn ({' '.join(str(exc).split())})") from None
         print(f"wrote {args.output}")
         return 0
     trajectory = Trajectory.load(args.file)
     source = gait_source(args)
-    out = Path(args.output)
     if source.robot is not None and source.robot.is_3d and getattr(args, "terrain", None) is None:
         from gaitbot.plot.balance import plot_balance
 
-        plot_balance(trajectory, source.robot, out, title=Path(args.file).name)
+        write_output(out, lambda path: plot_balance(trajectory, source.robot, path, title=Path(args.file).name))
         print(f"wrote {out}")
         return 0
     terrain = None
     if getattr(args, "terrain", None) is not None:
-        terrain = load_course(args.terrain).terrain
-    plot_trajectory(trajectory, source.geometry, out, clearance=source.settings.clearance, title=Path(args.file).name,
-                    terrain=terrain)
+        terrain = load_course(file_option(args.terrain, "--terrain")).terrain
+    write_output(out, lambda path: plot_trajectory(trajectory, source.geometry, path, clearance=source.settings.clearance,
+                                                   title=Path(args.file).name, terrain=terrain))
     print(f"wrote {out}")
     return 0

@@ -124,12 +124,16 @@ def _check_output(out: Path) -> None:
         raise UsageError(f"-o {out}: cannot write there (no such directory, or no permission)")
 
 
+#: The longest recording by hand one --duration may ask for (a day); without --duration: until Ctrl-C.
+MAX_DURATION_S = 86_400.0
+
+
 def samples_for(duration_s: float | None, rate_hz: float) -> int | None:
     """Samples in ``duration_s`` at ``rate_hz`` (None: until Ctrl-C); a file needs at least 2."""
     if duration_s is None:
         return None
-    if not (math.isfinite(duration_s) and duration_s > 0):
-        raise UsageError(f"--duration must be a positive number of seconds, got {duration_s!r}")
+    if not (math.isfinite(duration_s) and 0 < duration_s <= MAX_DURATION_S):
+        raise UsageError(f"--duration must be a number of seconds within 0..{MAX_DURATION_S:g}, got {duration_s!r}")
     n = int(round(duration_s * rate_hz))
     if n < 2:
         raise UsageError(f"--duration {duration_s:g} s holds fewer than 2 samples at {rate_hz:g} Hz "

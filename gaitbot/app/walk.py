@@ -9,10 +9,10 @@ from __future__ import annotations
 import sys
 
 from gaitbot.app.hardware import serial_port, warn_about_latency
-from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, load_robot
+from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
-from gaitbot.bus.log import BusRecorder
+from gaitbot.bus.log import BusRecorder, RecordingFailed
 from gaitbot.check.preflight import preflight
 from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
 from gaitbot.robot.gains import gain_notes, gain_writes
@@ -75,14 +75,24 @@ def run(args) -> int:
     if hardware:
         warn_about_latency(port)
     recorder = None
-    if args.record:
+    if args.record is not None:
+        file_option(args.record, "--record")
         joints = {j.name: j.id for j in config.joints}
-        recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now)
-    if sim is not None:
-        bus = guarded(config, sim.make_bus(clock.now, recorder))
-    else:
-        bus = make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,
-                             reply_timeout_ms=args.reply_timeout_ms)
+        recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now,
+                               rate_hz=source.settings.rate_hz)
+    try:  # the recording's header is written here, before anything is sent
+        if sim is not None:
+            bus = guarded(config, sim.make_bus(clock.now, recorder))
+        else:
+            bus = make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,
+                                 reply_timeout_ms=args.reply_timeout_ms)
+    except (OSError, RecordingFailed) as exc:
+        if recorder is None:
+            raise
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        if isinstance(exc, RecordingFailed) and isinstance(exc.__cause__, OSError):
+            reason = exc.__cause__.strerror or exc.__cause__
+        raise UsageError(f"--record {args.record}: cannot write the recording ({reason}); nothing was sent") from None
     velocity, acceleration = joint_limits_ticks(config)
     for note in gain_notes(config):
         print(f"note: {note}", file=sys.stderr)

@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gaitbot.app.options import UsageError, check_rate_option, gait_source, step_lengths
+from gaitbot.app.options import UsageError, check_rate_option, file_option, gait_source, step_lengths
 from gaitbot.gait.segments import GaitGenerationError
 from gaitbot.gait.step_length import StepLengthError
 from gaitbot.gait.terrain.course_file import load_course
@@ -26,6 +26,15 @@ def build_walk(args) -> tuple[GaitSource, OnlineWalker]:
         return source, plan_walk(source.geometry, steps, source.settings)
     except StepLengthError as exc:
         raise UsageError(str(exc)) from None
+    except GaitGenerationError as exc:
+        raise UsageError(f"{leg_origin(args, source)}: {exc}") from None
+
+
+def leg_origin(args, source: GaitSource) -> str:
+    """Where the leg and gait settings of a walk come from, for a message about a walk they cannot make."""
+    flags = [f"--{name}" for name in ("thigh", "shank", "foot", "clearance", "rate") if getattr(args, name, None) is not None]
+    where = f"{source.robot.path}: geometry and gait" if source.robot is not None else "the leg"
+    return where + (f" with {', '.join(flags)}" if flags else "")
 
 
 @dataclass(frozen=True)
@@ -48,7 +57,7 @@ def trajectory_file_walk(args) -> tuple[GaitSource, FileWalk, Trajectory]:
     if getattr(args, "rate", None) is not None:
         raise UsageError("--rate: a trajectory file is walked at its own frame rate; leave --rate out")
     source = gait_source(args)
-    trajectory = Trajectory.load(args.trajectory)
+    trajectory = Trajectory.load(file_option(args.trajectory, "--trajectory"))
     periods = np.diff(trajectory.t_s)
     period = float(np.median(periods))
     worst = float(np.abs(periods - period).max())
@@ -87,7 +96,7 @@ def pelvis_root(source: GaitSource, trajectory: Trajectory) -> Trajectory:
 def build_terrain_walk(args):
     """Footholds, pelvis search and trajectory for ``--terrain FILE`` (seed 003 joined to the flat walker)."""
     source = gait_source(args)
-    course = load_course(args.terrain)
+    course = load_course(file_option(args.terrain, "--terrain"))
     settings = terrain_settings(source, course, getattr(args, "clearance", None))
     try:
         walk = plan_terrain_walk(make_context(source.geometry, source.settings), course.terrain, course.start_m,

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 
 from gaitbot.servos.health import HealthReading
 from gaitbot.servos.registers import RegisterWrite
@@ -56,6 +57,30 @@ class ServoStatusError(BusError):
         self.fault = fault
 
 
+@dataclass(frozen=True)
+class ReadBack:
+    """One budgeted, non-blocking read of one servo (:meth:`Bus.read_back`), as the session sees it.
+
+    outcome: "answered" (a status packet that answers this very request, in budget), "missed" (none
+    in budget: the read is abandoned for this frame), "damaged" (only a damaged status packet in
+    budget), "skipped" (no budget left in the frame: nothing was sent, nothing is counted).
+    ticks: present position when answered. data: the register block read (``set_read_back_blocks``),
+    when answered. error: the status packet's error byte. late_s: how late this servo's latest
+    reply to an abandoned read came, if one came since the last read-back (None: none seen).
+    """
+
+    servo_id: int
+    outcome: str
+    ticks: int | None = None
+    data: bytes = b""
+    error: int = 0
+    late_s: float | None = None
+
+    @property
+    def answered(self) -> bool:
+        return self.outcome == "answered"
+
+
 class Bus(ABC):
     """A chain of servos on one serial bus.
 
@@ -98,6 +123,23 @@ class Bus(ABC):
         model has it) present load (gaitbot.servos.health). Retried like a present-position read."""
         raise NotImplementedError(f"{type(self).__name__} cannot read servo health")
 
+    def set_read_back_blocks(self, blocks: dict[int, tuple[int, int]]) -> None:
+        """Make ``read_back`` read these registers (servo id -> (address, length), the present position
+        inside them) instead of the present position alone; its ``data`` then holds them. In-memory buses,
+        which read no registers, ignore it."""
+
+    def read_back(self, servo_id: int, budget_s: float) -> ReadBack:
+        """Read one servo back within ``budget_s`` seconds, never longer, never retried (the per-frame
+        read of a walk session: docs/bus-faults.md). Backends that talk to servos override this; the
+        default asks ``read_present_ticks`` (which may block: for in-memory buses only)."""
+        if budget_s <= 0:
+            return ReadBack(servo_id, "skipped")
+        try:
+            ticks = self.read_present_ticks([servo_id]).get(servo_id)
+        except ServoTimeout:
+            return ReadBack(servo_id, "missed")
+        return ReadBack(servo_id, "answered" if ticks is not None else "missed", ticks)
+
     def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
         """Write a setting (a gain, a lock flag) to each servo, waiting for each one's status packet.
 
@@ -113,5 +155,5 @@ class Bus(ABC):
         self.close()
 
 
-__all__ = ["Bus", "HealthReading", "BusError", "PortError", "ServoTimeout", "ServoLate", "CorruptReplies",
+__all__ = ["Bus", "HealthReading", "BusError", "ReadBack", "PortError", "ServoTimeout", "ServoLate", "CorruptReplies",
            "ServoStatusError", "RegisterWrite"]

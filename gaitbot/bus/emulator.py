@@ -695,11 +695,13 @@ class EmulatedChain(MockPort):
             packet[-1] ^= 0x5A  # checksum (v1) or CRC high byte (v2) no longer matches
         table, model = self.tables[servo_id], self.models[servo_id]
         delay_s = table[LAYOUTS[model.name].return_delay_addr] * 2e-6
-        if active:
-            delay_s += self.faults.late_s.get(servo_id, 0.0)
+        late_s = self.faults.late_s.get(servo_id, 0.0) if active else 0.0
         send_s = max(self.now_s, self._busy_until_s) + delay_s
-        rate = self._instruction_rate or self.baudrate
-        self._busy_until_s = send_s + len(packet) * 10 / rate
+        if late_s:  # a servo that is slow to answer does not hold the line while it thinks: others go on
+            send_s += late_s
+        else:
+            rate = self._instruction_rate or self.baudrate
+            self._busy_until_s = send_s + len(packet) * 10 / rate
         self.rx_packets.append(bytes(packet))
         self.outbox.append((send_s, bytes(packet), self._instruction_rate))
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 
-from gaitbot.bus.base import Bus, BusError
+from gaitbot.bus.base import Bus, BusError, ReadBack
 
 
 class GoalOutsideLimits(BusError):
@@ -53,6 +53,12 @@ class LimitGuard(Bus):
 
     def read_health(self, servo_id: int):
         return self.inner.read_health(servo_id)
+
+    def read_back(self, servo_id: int, budget_s: float) -> ReadBack:
+        return self.inner.read_back(servo_id, budget_s)
+
+    def set_read_back_blocks(self, blocks: dict[int, tuple[int, int]]) -> None:
+        self.inner.set_read_back_blocks(blocks)
 
     def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
         """Settings are not goals: passed on (the backend refuses a write to the goal or torque register)."""

@@ -27,21 +27,34 @@ import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, BinaryIO
 
 import numpy as np
 
+from gaitbot.bus.base import BusError
 from gaitbot.errors import UserError
+from gaitbot.fields import read_user_file
+from gaitbot.robot.config import RATE_RANGE_HZ
 from gaitbot.servos import BACKENDS, wire
 from gaitbot.servos.models import ServoModel, servo_model
 
 LOG_FORMAT = "gaitbot-bus-log"
 LOG_VERSION = 1
+MAX_HEADER_CHARS = 1_000_000
 _HEADER_KEYS = ("backend", "protocol", "baudrate", "robot", "joints", "models")
 
 
 class RecordingError(UserError, ValueError):
     """A bus log cannot be read; the message names the file, the line and the problem."""
+
+
+class RecordingFailed(BusError):
+    """The recording could not be written (a full disk, a failing drive) while the bus itself is fine.
+
+    Raised once, from the packet that could not be logged; the recorder then stops writing (what was
+    written stays, each line whole but possibly the last) and the session stops the walk with its
+    normal ramp, which still goes out on the healthy port. Not an OSError, so the bus never takes it
+    for a failure of the serial port."""
 
 
 # ---------------------------------------------------------------------------------------------- writing
@@ -51,13 +64,16 @@ class BusRecorder:
     """Writes one bus log. ``clock`` returns seconds (monotonic); injectable for tests."""
 
     def __init__(self, path: str | Path, *, robot: str, joints: Mapping[str, int],
-                 clock: Callable[[], float] = time.monotonic) -> None:
+                 clock: Callable[[], float] = time.monotonic, rate_hz: float | None = None) -> None:
         self.path = Path(path)
+        self.rate_hz = rate_hz  # the frame rate of the run, written in the header (gaitbot check uses it)
         self.robot = robot
         self.joints = dict(joints)
         self._clock = clock
         self._t0_s: float | None = None
-        self._file: TextIO | None = None
+        self._file: BinaryIO | None = None
+        self.failed: OSError | None = None  # the write that failed; nothing is written after it
+        self.lines_written = 0
 
     def start(self, *, backend: str, protocol: float, baudrate: int, models: Mapping[int, ServoModel]) -> None:
         """Open the file and write the header; the clock's zero is now."""
@@ -66,9 +82,15 @@ class BusRecorder:
         header = {"format": LOG_FORMAT, "version": LOG_VERSION, "backend": backend, "protocol": float(protocol),
                   "baudrate": int(baudrate), "robot": self.robot, "joints": self.joints,
                   "models": {str(i): m.name for i, m in models.items()}}
-        self._file = open(self.path, "w", encoding="utf-8")
+        if self.rate_hz is not None:
+            header["rate_hz"] = float(self.rate_hz)
+        self._file = open(self.path, "wb", buffering=0)  # one os-level write per line: no buffer to lose
         self._t0_s = self._clock()
-        self._write_line(header)
+        try:
+            self._write_line(header)
+        except RecordingFailed:
+            self.close()
+            raise
 
     def wrap(self, port_handler: Any, *, backend: str, protocol: float, baudrate: int,
              models: Mapping[int, ServoModel]) -> "RecordingPort":
@@ -76,15 +98,23 @@ class BusRecorder:
         self.start(backend=backend, protocol=protocol, baudrate=baudrate, models=models)
         return RecordingPort(port_handler, self, wire.framing_for(backend, protocol))
 
-    def log(self, direction: str, data: bytes) -> None:
+    def now(self) -> float:
+        return self._clock()
+
+    def log(self, direction: str, data: bytes, at_s: float | None = None) -> None:
+        if self.failed is not None:
+            return  # the recording already failed (and said so once): the walk's stop goes on without it
         if self._file is None or self._t0_s is None:
             raise RuntimeError(f"recorder {self.path} not started")
-        t_s = round(self._clock() - self._t0_s, 6)
+        t_s = round((self._clock() if at_s is None else at_s) - self._t0_s, 6)
         self._write_line({"t": t_s, "dir": direction, "hex": bytes(data).hex()})
 
     def close(self) -> None:
         if self._file is not None:
-            self._file.close()
+            try:
+                self._file.close()
+            except OSError as exc:  # nothing is buffered; a failing close is only noted
+                self.failed = self.failed or exc
             self._file = None
 
     def __enter__(self) -> "BusRecorder":
@@ -95,8 +125,19 @@ class BusRecorder:
 
     def _write_line(self, obj: dict) -> None:
         assert self._file is not None
-        self._file.write(json.dumps(obj, separators=(",", ":")) + "\n")
-        self._file.flush()
+        data = (json.dumps(obj, separators=(",", ":")) + "\n").encode("utf-8")
+        try:
+            written = self._file.write(data)
+            while written is not None and written < len(data):  # a raw write may be short; finish the line
+                more = self._file.write(data[written:])
+                if not more:
+                    raise OSError(28, "No space left on device")
+                written += more
+        except OSError as exc:
+            self.failed = exc
+            raise RecordingFailed(f"the recording {self.path} could not be written ({exc.strerror or exc}) after "
+                                  f"{self.lines_written} lines; what was written is kept") from exc
+        self.lines_written += 1
 
 
 class RecordingPort:
@@ -114,8 +155,9 @@ class RecordingPort:
 
     def writePort(self, packet) -> int:  # noqa: N802 (SDK name)
         self._flush_rx(partial=True)
+        sent_s = self._recorder.now()  # stamped as it is handed to the port, not after (a busy host may pause there)
         written = self._inner.writePort(packet)
-        self._recorder.log("tx", bytes(packet))
+        self._recorder.log("tx", bytes(packet), at_s=sent_s)
         return written
 
     def readPort(self, length: int):  # noqa: N802
@@ -202,11 +244,13 @@ def read_log(path: str | Path, *, allow_partial_last_line: bool = False) -> BusL
     cannot be read as a bus log; bad bytes inside a packet are left for the checks."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_user_file(path).decode("utf-8")
     except FileNotFoundError:
         raise RecordingError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RecordingError(f"{path}: cannot read ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise RecordingError(f"{path}: cannot read (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
+    except OSError as exc:
+        raise RecordingError(f"{path}: cannot read ({exc.strerror or exc})") from None
     lines = text.split("\n")
     dropped = None
     if lines and lines[-1] == "":
@@ -228,41 +272,82 @@ def read_header(path: str | Path) -> dict:
     """The validated header alone (the first line), without reading the rest of the file."""
     path = Path(path)
     try:
+        if not path.is_file():
+            read_user_file(path, 0)  # the reason: missing, a directory, a FIFO or a device
         with open(path, encoding="utf-8") as f:
-            first = f.readline()
+            first = f.readline(MAX_HEADER_CHARS)
     except FileNotFoundError:
         raise RecordingError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RecordingError(f"{path}: cannot read ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise RecordingError(f"{path}: cannot read (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
+    except OSError as exc:
+        raise RecordingError(f"{path}: cannot read ({exc.strerror or exc})") from None
     if not first.strip():
         raise RecordingError(f"{path}:1: empty file, no {LOG_FORMAT} header")
     return _header(path, first)
 
 
 def _header(path: Path, line: str) -> dict:
+    where = f"{path}:1"
     try:
         header = json.loads(line)
     except json.JSONDecodeError as exc:
-        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (line 1 is not JSON: {exc.msg})") from None
+        raise RecordingError(f"{where}: no {LOG_FORMAT} header (line 1 is not JSON: {exc.msg})") from None
+    except RecursionError:
+        raise RecordingError(f"{where}: no {LOG_FORMAT} header (line 1 is nested too deeply)") from None
     if not isinstance(header, dict) or header.get("format") != LOG_FORMAT:
-        raise RecordingError(f"{path}:1: no {LOG_FORMAT} header (the first line must be "
+        raise RecordingError(f"{where}: no {LOG_FORMAT} header (the first line must be "
                              f"{{\"format\": \"{LOG_FORMAT}\", ...}}; is the file a bus recording, complete from its start?)")
-    if header.get("version") != LOG_VERSION:
-        raise RecordingError(f"{path}:1: unsupported log version {header.get('version')!r} (reads {LOG_VERSION})")
+    if header.get("version") != LOG_VERSION or isinstance(header.get("version"), bool):
+        raise RecordingError(f"{where}: unsupported log version {_shown(header.get('version'))} (reads {LOG_VERSION})")
     missing = [k for k in _HEADER_KEYS if k not in header]
     if missing:
-        raise RecordingError(f"{path}:1: header lacks {', '.join(missing)}")
+        raise RecordingError(f"{where}: header lacks {', '.join(missing)}")
+    backend, protocol, baudrate = header["backend"], header["protocol"], header["baudrate"]
+    if not isinstance(backend, str) or backend not in BACKENDS:
+        raise RecordingError(f"{where}: header backend must be {' or '.join(BACKENDS)}, got {_shown(backend)}")
+    if not _is_number(protocol) or float(protocol) not in (1.0, 2.0):
+        raise RecordingError(f"{where}: header protocol must be 1.0 or 2.0, got {_shown(protocol)}")
+    if backend == "feetech" and float(protocol) != 1.0:
+        raise RecordingError(f"{where}: header protocol of a feetech bus must be 1.0, got {_shown(protocol)}")
+    if isinstance(baudrate, bool) or not isinstance(baudrate, int) or not 0 < baudrate <= 100_000_000:
+        raise RecordingError(f"{where}: header baudrate must be a whole number of bits per second, "
+                             f"got {_shown(baudrate)}")
+    if not isinstance(header["robot"], str):
+        raise RecordingError(f"{where}: header robot must be a name (a string), got {_shown(header['robot'])}")
+    if "rate_hz" in header:
+        low, high, _unit = RATE_RANGE_HZ
+        rate = header["rate_hz"]
+        if not _is_number(rate) or not low <= float(rate) <= high:
+            raise RecordingError(f"{where}: header rate_hz must be a frame rate within {low:g}..{high:g} Hz, "
+                                 f"got {_shown(rate)}")
     joints, models = header["joints"], header["models"]
     if not isinstance(joints, dict) or not isinstance(models, dict):
-        raise RecordingError(f"{path}:1: header joints and models must be objects")
-    try:
-        for name in typed_header(header)["models"].values():
+        raise RecordingError(f"{where}: header joints and models must be objects")
+    for name, servo_id in joints.items():
+        if isinstance(servo_id, bool) or not isinstance(servo_id, int) or not 0 <= servo_id <= 253:
+            raise RecordingError(f"{where}: header joints.{name} must be a servo id 0..253, got {_shown(servo_id)}")
+    for key, name in models.items():
+        if not key.isdigit() or not 0 <= int(key) <= 253 or not isinstance(name, str):
+            raise RecordingError(f"{where}: header models must map servo ids 0..253 to model names, got "
+                                 f"{_shown(key)}: {_shown(name)}")
+        try:
             servo_model(name)
-    except (TypeError, ValueError, KeyError) as exc:
-        raise RecordingError(f"{path}:1: bad header joints/models/protocol: {exc}") from None
-    if header["backend"] not in BACKENDS:
-        raise RecordingError(f"{path}:1: unknown backend {header['backend']!r} ({' or '.join(BACKENDS)})")
+        except (TypeError, ValueError, KeyError) as exc:
+            raise RecordingError(f"{where}: header models.{key}: {' '.join(str(exc).split())}") from None
     return header
+
+
+def _is_number(value: Any) -> bool:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    return abs(value) < 1e300 if isinstance(value, int) else math.isfinite(value)
+
+
+def _shown(value: Any) -> str:
+    """A header value in a message: short, one line."""
+    text = json.dumps(value) if isinstance(value, (str, int, float, bool, type(None))) else type(value).__name__
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def typed_header(header: dict) -> dict:
@@ -277,17 +362,16 @@ def _line(path: Path, line_no: int, line: str) -> LogLine:
         obj = json.loads(line)
     except json.JSONDecodeError as exc:
         raise RecordingError(f"{path}:{line_no}: bad JSON ({exc.msg}); not a bus recording line") from None
+    except RecursionError:
+        raise RecordingError(f"{path}:{line_no}: nested too deeply; not a bus recording line") from None
     if not isinstance(obj, dict) or not all(k in obj for k in ("t", "dir", "hex")):
         raise RecordingError(f"{path}:{line_no}: not a packet line (needs t, dir, hex)")
-    try:
-        t_s = float(obj["t"])
-    except (TypeError, ValueError):
-        raise RecordingError(f"{path}:{line_no}: t is not a number: {obj['t']!r}") from None
-    if not math.isfinite(t_s):
-        raise RecordingError(f"{path}:{line_no}: t is not a finite number: {obj['t']!r}")
+    if not _is_number(obj["t"]):
+        raise RecordingError(f"{path}:{line_no}: t must be a finite number of seconds, got {_shown(obj['t'])}")
+    t_s = float(obj["t"])
     direction, hex_text = obj["dir"], obj["hex"]
-    if direction not in ("tx", "rx"):
-        raise RecordingError(f"{path}:{line_no}: dir must be \"tx\" or \"rx\", got {direction!r}")
+    if not isinstance(direction, str) or direction not in ("tx", "rx"):
+        raise RecordingError(f"{path}:{line_no}: dir must be \"tx\" or \"rx\", got {_shown(direction)}")
     if not isinstance(hex_text, str):
         raise RecordingError(f"{path}:{line_no}: hex must be a string")
     try:

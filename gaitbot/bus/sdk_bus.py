@@ -13,7 +13,9 @@ from contextlib import contextmanager
 from types import ModuleType
 from typing import Any
 
-from gaitbot.bus.base import Bus, BusError, CorruptReplies, PortError, ServoLate, ServoStatusError, ServoTimeout
+from gaitbot.bus.base import (Bus, BusError, CorruptReplies, PortError, ReadBack, ServoLate, ServoStatusError,
+                              ServoTimeout)
+from gaitbot.bus.log import RecordingFailed
 from gaitbot.servos import dynamixel, has_sync_read, max_servo_id, wire
 from gaitbot.servos.health import HealthReading, decode_health, health_block
 from gaitbot.servos.models import ServoModel
@@ -31,10 +33,25 @@ LIST_PORTS_HINT = "list serial ports with: python -m serial.tools.list_ports -v"
 #: other end stopped reading). A 60 Hz frame is at most a few hundred bytes, so half a second
 #: is only ever reached when the port is dead.
 WRITE_TIMEOUT_S = 0.5
-#: After a status packet did not come within the SDK's reply timeout, listen this long for it.
-#: A reply arriving now was late, not lost: the servo (or the adapter) is too slow, and its next
-#: answers would be taken for answers to later questions, so the bus stops (ServoLate).
-LATE_REPLY_WATCH_MS = 40.0
+#: Blocking exchanges (ping, torque, settings, the start-up reads): after a status packet did not come
+#: within the SDK's reply timeout, listen this long for it before asking again. A reply arriving now
+#: was late, not lost: the servo (or the adapter) is too slow, and its answers would be taken for
+#: answers to later questions, so the bus stops (ServoLate) naming it. Long enough that a servo up to
+#: about 230 ms late at start-up is named before any goal is written.
+LATE_REPLY_WATCH_MS = 200.0
+#: The per-frame read-back (``read_back``) asks for the register block with a length that differs
+#: from every earlier request of that servo still unanswered (base length + 0, 1, 2, ...), so a late
+#: reply to an abandoned read is never taken as the answer to a later one: the status packet must
+#: carry exactly the parameters asked for. This many lengths: at most this many reads unanswered.
+READ_BACK_LENGTHS = 8
+#: An abandoned read-back whose reply has not come after this long is written off as lost.
+STALE_REPLY_HORIZON_S = 1.0
+#: A read-back with less budget than this left in its frame is not sent (outcome "skipped").
+MIN_READ_BACK_BUDGET_S = 0.5e-3
+#: Before torque goes off after abandoned read-backs, the bus waits at most this long for the line to go quiet.
+QUIET_WAIT_S = 0.25
+#: An attempt of a blocking exchange whose status packet came during the late-reply watch.
+LATE_REPLY = "late"
 #: Linux pseudo-terminal slaves (Unix98 ptys) have device majors 136..143.
 _PTY_MAJORS = range(136, 144)
 
@@ -90,6 +107,13 @@ class SdkBus(Bus):
         self._read_group: Any = None  # one GroupSyncRead per bus, re-addressed only when the ids change
         self._is_open = False
         self._timed_out_ids: set[int] = set()  # servos whose last attempt timed out (late-reply evidence)
+        #: The per-frame read-back's register block per servo (address, length): the present position unless
+        #: ``set_read_back_blocks`` gave a wider block holding it (the health block), decoded from inside it.
+        self.read_back_blocks: dict[int, tuple[int, int]] = {}
+        self._abandoned: dict[int, list[tuple[int, float]]] = {}  # servo -> [(length asked, sent at)] unanswered
+        self._late_seen: dict[int, float] = {}  # servo -> lateness of its latest reply to an abandoned read
+        self._damaged_seen: dict[int, int] = {}  # servo -> damaged status packets seen since its last read-back
+        self.collected_bytes = 0  # bytes the last look at stale input found
         self.open_notes: list[str] = []  # how the port was opened, when that differs from the config
 
     # --- hooks for subclasses -------------------------------------------------------------
@@ -182,16 +206,26 @@ class SdkBus(Bus):
         """Turn an OS-level failure of the port inside the SDK into PortError (never retried)."""
         try:
             yield
+        except RecordingFailed:  # the recorder under the port failed, not the port: the bus goes on
+            self._release_port()
+            raise
         except PORT_EXCEPTIONS as exc:
-            try:
-                self.port.is_using = False  # the SDK's lock, left taken by the exchange that failed
-            except AttributeError:
-                pass
+            self._release_port()
             raise PortError(f"serial port {self.port_name} failed: {exc} (the adapter was unplugged or the "
                             "port closed)", servo_id=servo_id) from exc
 
+    def _release_port(self) -> None:
+        try:
+            self.port.is_using = False  # the SDK's lock, left taken by the exchange that failed
+        except AttributeError:
+            pass
+
     def ping(self, servo_id: int) -> bool:
+        """True if the servo answers (retried). For a configured servo, a silent attempt is followed by the
+        late-reply watch: a reply that comes then is consumed (never taken as the answer to the next
+        attempt), and a servo whose every attempt was answered only late raises ServoLate, named."""
         self._require_open()
+        late = 0
         for _ in range(1 + self.retries):
             self._before_transaction()
             with self._port_guard(servo_id):
@@ -199,9 +233,14 @@ class SdkBus(Bus):
                 model_number, result, error = self._ph.ping(self.port, servo_id)
             self._raise_on_port_failure(result, servo_id)
             if result == self.sdk.COMM_SUCCESS:
+                self._timed_out_ids.discard(servo_id)
                 self.last_status_errors[servo_id] = error
                 self.model_numbers[servo_id] = model_number  # the SDKs read it with the ping (2.0: in the status)
                 return True
+            if result == self.sdk.COMM_RX_TIMEOUT and servo_id in self.models:
+                late += self._watch_for_late_reply(servo_id)
+        if late:
+            raise self._late(servo_id, f"to {late} of {1 + self.retries} pings")
         return False
 
     def set_torque(self, ids: Iterable[int], enabled: bool) -> None:
@@ -212,11 +251,14 @@ class SdkBus(Bus):
         bits are recorded in ``last_status_errors`` and not raised when disabling.
         """
         self._require_open()
+        if not enabled and self._abandoned_any():
+            self._wait_for_quiet()  # late replies still on their way would be taken for the servos' answers
         failures: list[BusError] = []
         for servo_id in ids:
             self._model(servo_id)
             try:
-                self._write_confirmed(servo_id, self._torque_addr, bytes([1 if enabled else 0]), raise_status=enabled)
+                self._write_confirmed(servo_id, self._torque_addr, bytes([1 if enabled else 0]), raise_status=enabled,
+                                      quick=not enabled)
             except BusError as exc:
                 if enabled:
                     raise
@@ -274,6 +316,8 @@ class SdkBus(Bus):
                 group.addParam(servo_id, data)
         self._before_transaction()
         with self._port_guard():
+            if self._abandoned_any():
+                self._collect_stale_input()  # before the SDK's clearPort drops a late reply unseen
             result = group.txPacket()
         self._raise_on_port_failure(result, None)
         if result != self.sdk.COMM_SUCCESS:
@@ -299,6 +343,138 @@ class SdkBus(Bus):
         self._require_open()
         block = health_block(self._model(servo_id))
         return decode_health(block, servo_id, self._read_block(servo_id, block.address, block.length))
+
+    def set_read_back_blocks(self, blocks: dict[int, tuple[int, int]]) -> None:
+        for servo_id, (address, length) in blocks.items():
+            start, size = self._present
+            if not (address <= start and start + size <= address + length):
+                raise ValueError(f"servo {servo_id}: a read-back block {address}..{address + length} must hold the "
+                                 f"present position ({start}..{start + size})")
+        self.read_back_blocks = dict(blocks)
+
+    def read_back(self, servo_id: int, budget_s: float) -> ReadBack:
+        """One READ of the servo's read-back block (``set_read_back_blocks``) that waits at most ``budget_s`` and is never
+        retried: the per-frame read of a walk session (docs/bus-faults.md, "The read-back").
+
+        Input left over from earlier exchanges is read and dropped first (a late reply among it is
+        matched to the abandoned read it answers, by id and length, and its lateness noted). The request
+        goes out through the SDK; the status packet is awaited on the port's packet timeout capped to the
+        budget, and accepted only if it has this servo's id, is a status packet and carries exactly the
+        parameters asked for. Error bits raise ServoStatusError (the Hardware Error Status is read in
+        what is left of the budget); a dead port raises PortError.
+        """
+        self._require_open()
+        self._model(servo_id)
+        late_s = self._late_seen.pop(servo_id, None)
+        if not budget_s >= MIN_READ_BACK_BUDGET_S:
+            return ReadBack(servo_id, "skipped", late_s=late_s)
+        start_s = time.monotonic()
+        address, base_length = self.read_back_blocks.get(servo_id, self._present)
+        abandoned = self._abandoned.setdefault(servo_id, [])
+        abandoned[:] = [(n, t) for n, t in abandoned if start_s - t < STALE_REPLY_HORIZON_S]
+        used = {n for n, _ in abandoned}
+        free = [base_length + extra for extra in range(READ_BACK_LENGTHS) if base_length + extra not in used]
+        if not free:  # every length still owed a reply: asking again could not be told apart
+            return ReadBack(servo_id, "missed", late_s=late_s)
+        length = free[0]
+        outcome, frame = self._budgeted_read(servo_id, address, length, budget_s, start_s)
+        late_s = self._late_seen.pop(servo_id, late_s)
+        if frame is None:
+            if outcome != "damaged":
+                abandoned.append((length, start_s))
+            if outcome == "missed" and self._damaged_seen.pop(servo_id, 0):
+                outcome = "damaged"  # its reply to an earlier read came, damaged: the same fault, seen late
+            return ReadBack(servo_id, outcome, late_s=late_s)
+        data = bytes(frame.params)
+        error = frame.error or 0
+        self.last_status_errors[servo_id] = error
+        self._timed_out_ids.discard(servo_id)
+        if error:
+            remaining_s = budget_s - (time.monotonic() - start_s)
+            raise self._status_error(servo_id, error, budget_s=remaining_s)
+        offset = self._present[0] - address
+        ticks = self._decode(data[offset:offset + self._present[1]], self._model(servo_id))
+        return ReadBack(servo_id, "answered", ticks, data, error, late_s)
+
+    def _budgeted_read(self, servo_id: int, address: int, length: int, budget_s: float,
+                       start_s: float) -> tuple[str, wire.Frame | None]:
+        """Send READ(address, length) to ``servo_id`` through the SDK and wait for its status packet until
+        ``start_s + budget_s``: ("answered", frame), ("damaged", None) or ("missed", None)."""
+        self._before_transaction()
+        with self._port_guard(servo_id):
+            self._drop_stale_input()
+            result = self._ph.readTx(self.port, servo_id, address, length)
+            if result != self.sdk.COMM_SUCCESS:
+                self.port.is_using = False
+                self._raise_on_port_failure(result, servo_id)
+                return "missed", None
+            remaining_ms = max(0.0, budget_s - (time.monotonic() - start_s)) * 1000.0
+            try:
+                return self._await_status(servo_id, length, remaining_ms)
+            finally:
+                self.port.is_using = False  # readTx took the SDK's lock; no rxPacket of the SDK releases it
+
+    def _await_status(self, servo_id: int, length: int, timeout_ms: float) -> tuple[str, wire.Frame | None]:
+        framing = wire.framing_for(self.family, self.protocol)
+        self.port.setPacketTimeoutMillis(timeout_ms)  # the port's clock: virtual on the mock, real on a port
+        buffer = bytearray()
+        damaged = False
+        while True:
+            available = self.port.getBytesAvailable()
+            if available:
+                buffer += bytes(self.port.readPort(available))
+                for raw, is_packet in wire.split_complete(buffer, framing):
+                    if not is_packet:
+                        continue
+                    frame = wire.parse(raw, framing, status=True)
+                    if self._answers(frame, servo_id, length, framing):
+                        return "answered", frame
+                    if frame.packet_id == servo_id and not frame.checksum_ok:
+                        damaged = True
+                    elif not self._note_stale_status(frame) and not frame.checksum_ok \
+                            and self._abandoned.get(frame.packet_id):
+                        self._damaged_seen[frame.packet_id] = self._damaged_seen.get(frame.packet_id, 0) + 1
+            elif self.port.isPacketTimeout():
+                return ("damaged" if damaged else "missed"), None
+            else:
+                time.sleep(0.0002)
+
+    def _wait_for_quiet(self, quiet_s: float = 0.03, at_most_s: float = QUIET_WAIT_S) -> None:
+        """Read (and note) whatever still arrives until the line has been quiet for ``quiet_s``, at most
+        ``at_most_s``: after read-backs were abandoned, their late replies are still coming."""
+        start = last = time.monotonic()
+        while True:
+            with self._port_guard():
+                self._collect_stale_input()
+            now = time.monotonic()
+            if self.collected_bytes:
+                last = now
+            if now - last >= quiet_s or now - start >= at_most_s:
+                return
+            time.sleep(0.001)
+
+    def _abandoned_any(self) -> bool:
+        return any(self._abandoned.values())
+
+    @staticmethod
+    def _answers(frame: wire.Frame, servo_id: int, length: int, framing: str) -> bool:
+        return (frame.checksum_ok and frame.packet_id == servo_id and len(frame.params) == length
+                and (framing == "v1" or frame.instruction == wire.INST_STATUS_V2))
+
+    def _note_stale_status(self, frame: wire.Frame) -> bool:
+        """A status packet that answers an abandoned read-back (same id, same length): note how late it
+        came and forget that request. True if it did."""
+        if not frame.checksum_ok:
+            return False
+        abandoned = self._abandoned.get(frame.packet_id)
+        if not abandoned:
+            return False
+        for k, (length, sent_s) in enumerate(abandoned):
+            if length == len(frame.params):
+                del abandoned[k]
+                self._late_seen[frame.packet_id] = time.monotonic() - sent_s
+                return True
+        return False
 
     # --- internals ------------------------------------------------------------------------
     def _sync_read(self, wanted: list[int]) -> dict[int, int]:
@@ -361,34 +537,57 @@ class SdkBus(Bus):
         if error:
             raise self._status_error(servo_id, error)
 
-    def _status_error(self, servo_id: int, error: int) -> ServoStatusError:
+    def _status_error(self, servo_id: int, error: int, budget_s: float | None = None) -> ServoStatusError:
+        """ServoStatusError naming the fault; on Dynamixel 2.0 the Hardware Error Status is read once to say
+        what the Alert bit means: blocking, or within ``budget_s`` (the read-back's frame) when given."""
         model = self._model(servo_id)
         hardware = None
         address = hardware_error_address(model.name)
         if self.family == "dynamixel" and self.protocol == 2.0 and error & dynamixel.V2_ALERT and address is not None:
             try:  # one attempt: the message is better with it, the stop does not depend on it
-                with self._port_guard(servo_id):
-                    self._drop_stale_input()
-                    value, result, _ = self._ph.read1ByteTxRx(self.port, servo_id, address)
-                hardware = value if result == self.sdk.COMM_SUCCESS else None
+                if budget_s is None:
+                    with self._port_guard(servo_id):
+                        self._drop_stale_input()
+                        value, result, _ = self._ph.read1ByteTxRx(self.port, servo_id, address)
+                    hardware = value if result == self.sdk.COMM_SUCCESS else None
+                elif budget_s >= MIN_READ_BACK_BUDGET_S:
+                    outcome, frame = self._budgeted_read(servo_id, address, 1, budget_s, time.monotonic())
+                    hardware = frame.params[0] if frame is not None else None
             except BusError:
                 hardware = None
         fault = describe_status_error(self.family, self.protocol, error, hardware, model.name)
         detail = f"status error 0x{error:02X}" + (f", hardware error status 0x{hardware:02X}" if hardware else "")
-        return ServoStatusError(f"servo {servo_id} on {self.port_name} reports {fault} ({detail})",
-                                servo_id=servo_id, status_error=error, fault=fault)
+        exc = ServoStatusError(f"servo {servo_id} on {self.port_name} reports {fault} ({detail})",
+                               servo_id=servo_id, status_error=error, fault=fault)
+        exc.detail_pending = hardware is None and address is not None and bool(error & dynamixel.V2_ALERT) \
+            and self.family == "dynamixel" and self.protocol == 2.0  # read it once the robot is safe
+        return exc
 
-    def _failed_attempt(self, servo_id: int, result: int, outcomes: dict[int, list[int]]) -> None:
-        """Note one failed attempt; after a silent one, listen for the servo's late status packet."""
+    def explain_status_error(self, exc: BusError) -> BusError:
+        """The same fault with the Hardware Error Status read (blocking, one attempt) if the read-back had no
+        time left for it in its frame: called by the session after the stop ramp, so the message says
+        which hardware error the Alert bit meant."""
+        if not (isinstance(exc, ServoStatusError) and getattr(exc, "detail_pending", False) and self._is_open):
+            return exc
+        try:
+            return self._status_error(exc.servo_id, exc.status_error)
+        except BusError:
+            return exc
+
+    def _failed_attempt(self, servo_id: int, result: int, outcomes: dict[int, list]) -> None:
+        """Note one failed attempt; after a silent one, listen for the servo's late status packet (a late
+        reply is consumed there, so the next attempt's answer cannot be confused with it)."""
         self._raise_on_port_failure(result, servo_id)
+        if result == self.sdk.COMM_RX_TIMEOUT and self._watch_for_late_reply(servo_id):
+            result = LATE_REPLY
         outcomes.setdefault(servo_id, []).append(result)
-        if result == self.sdk.COMM_RX_TIMEOUT:
-            self._timed_out_ids.add(servo_id)
-            self._watch_for_late_reply(servo_id)
 
-    def _no_answer(self, servo_id: int, results: list[int], what: str) -> ServoTimeout:
+    def _no_answer(self, servo_id: int, results: list, what: str) -> ServoTimeout:
         attempts = len(results)
         result = results[-1]
+        if LATE_REPLY in results:
+            late = sum(r == LATE_REPLY for r in results)
+            return self._late(servo_id, f"in {late} of {attempts} {what}")
         if all(r == self.sdk.COMM_RX_CORRUPT for r in results):
             return CorruptReplies(
                 f"servo {servo_id} on {self.port_name} sent a damaged status packet (bad checksum/CRC) in all "
@@ -401,13 +600,16 @@ class SdkBus(Bus):
             f"{how}: no status packet within the reply timeout; check its power, cable, id and baud rate",
             result_code=result, servo_id=servo_id)
 
-    def _watch_for_late_reply(self, servo_id: int) -> None:
-        """Listen up to LATE_REPLY_WATCH_MS for a status packet of ``servo_id``; ServoLate if one comes.
+    def _watch_for_late_reply(self, servo_id: int) -> bool:
+        """After a silent attempt: listen up to LATE_REPLY_WATCH_MS for a status packet of ``servo_id``.
+        True if one came (it is consumed: the attempt was answered late); False if none (the servo stays
+        suspect, and a still later reply of it seen before any later exchange raises ServoLate).
 
         Uses the port's own timeout (MockPort's is virtual), so a dry run costs no wall-clock time.
         """
+        self._timed_out_ids.add(servo_id)
         if not callable(getattr(self.port, "setPacketTimeoutMillis", None)):
-            return
+            return False
         buffer = bytearray()
         with self._port_guard(servo_id):
             self.port.setPacketTimeoutMillis(LATE_REPLY_WATCH_MS)
@@ -416,16 +618,17 @@ class SdkBus(Bus):
                 if available:
                     buffer += bytes(self.port.readPort(available))
                     if self._status_packet_from(buffer, servo_id):
-                        raise self._late(servo_id)
+                        self._timed_out_ids.discard(servo_id)
+                        return True
                 elif self.port.isPacketTimeout():
-                    return
+                    return False
                 else:
                     time.sleep(0.0002)
 
-    def _late(self, servo_id: int) -> ServoLate:
-        return ServoLate(f"servo {servo_id} on {self.port_name} answered late: its status packet arrived after "
-                         "the reply timeout (about 34 ms at 1 Mbaud); check its Return Delay Time and the "
-                         "adapter's latency timer", servo_id=servo_id)
+    def _late(self, servo_id: int, how: str = "") -> ServoLate:
+        return ServoLate(f"servo {servo_id} on {self.port_name} answered late{' ' + how if how else ''}: its "
+                         "status packet arrived after the reply timeout (about 34 ms at 1 Mbaud); check its Return "
+                         "Delay Time and the adapter's latency timer", servo_id=servo_id)
 
     def _status_packet_from(self, data: bytes | bytearray, servo_id: int) -> bool:
         framing = wire.framing_for(self.family, self.protocol)
@@ -438,10 +641,15 @@ class SdkBus(Bus):
                 return True
         return False
 
-    def _write_confirmed(self, servo_id: int, address: int, data: bytes, raise_status: bool = True) -> None:
-        """One WRITE instruction of ``data`` at ``address``, retried until the servo's status packet comes."""
-        result, error = self.sdk.COMM_SUCCESS, 0
-        for _ in range(1 + self.retries):  # rewriting the same bytes is harmless, so retry
+    def _write_confirmed(self, servo_id: int, address: int, data: bytes, raise_status: bool = True,
+                         quick: bool = False) -> None:
+        """One WRITE instruction of ``data`` at ``address``, retried until the servo's status packet comes.
+
+        ``quick`` (torque off at the end of a session): one retry and no late-reply watch, so a servo that
+        fell silent costs two reply timeouts, not a second, and the others are reached at once."""
+        result, error, late = self.sdk.COMM_SUCCESS, 0, 0
+        attempts = min(2, 1 + self.retries) if quick else 1 + self.retries
+        for _ in range(attempts):  # rewriting the same bytes is harmless, so retry
             self._before_transaction()
             with self._port_guard(servo_id):
                 self._drop_stale_input()
@@ -449,7 +657,11 @@ class SdkBus(Bus):
             self._raise_on_port_failure(result, servo_id)
             if result == self.sdk.COMM_SUCCESS:
                 break
+            if result == self.sdk.COMM_RX_TIMEOUT and not quick and self._watch_for_late_reply(servo_id):
+                late += 1
         else:
+            if late:
+                raise self._late(servo_id, f"to {late} of {attempts} writes to address {address}")
             shown = data[0] if len(data) == 1 else f"0x{data.hex()}"
             raise ServoTimeout(f"servo {servo_id} on {self.port_name} did not confirm writing {shown} to "
                                f"address {address} ({self._ph.getTxRxResult(result)})",
@@ -457,6 +669,33 @@ class SdkBus(Bus):
         self.last_status_errors[servo_id] = error
         if error and raise_status:
             raise self._status_error(servo_id, error)
+
+    def _collect_stale_input(self) -> bytes:
+        """Read whatever input is pending (a recording port logs it) and note the status packets among it
+        that answer abandoned read-backs (late, by id and length) or are damaged; return the rest.
+
+        Called before each goal write too: the SDK's txPacket clears the input buffer (Dynamixel's
+        clearPort), and a late reply dropped unseen could not be told from a lost one."""
+        self.collected_bytes = 0
+        available = getattr(self.port, "getBytesAvailable", None)
+        if not callable(available):
+            return b""
+        pending = available()
+        if not pending:
+            return b""
+        stale = bytes(self.port.readPort(pending))
+        self.collected_bytes = len(stale)
+        framing = wire.framing_for(self.family, self.protocol)
+        unmatched = bytearray()
+        for raw, is_packet in wire.split_complete(bytearray(stale), framing):
+            if is_packet:
+                frame = wire.parse(raw, framing, status=True)
+                if self._note_stale_status(frame):
+                    continue  # a late reply to an abandoned read-back: noted, not an answer to anything
+                if not frame.checksum_ok and self._abandoned.get(frame.packet_id):
+                    self._damaged_seen[frame.packet_id] = self._damaged_seen.get(frame.packet_id, 0) + 1
+            unmatched += raw
+        return bytes(unmatched)
 
     def _drop_stale_input(self) -> None:
         """Discard bytes left over from an earlier, timed-out exchange before asking anew.
@@ -466,14 +705,10 @@ class SdkBus(Bus):
         bytes are read first (a recording port logs them, so the recording stays complete), and a
         status packet among them from a servo that timed out is a late reply: ServoLate.
         """
-        available = getattr(self.port, "getBytesAvailable", None)
-        if callable(available):
-            pending = available()
-            if pending:
-                stale = bytes(self.port.readPort(pending))
-                for servo_id in sorted(self._timed_out_ids):
-                    if self._status_packet_from(stale, servo_id):
-                        raise self._late(servo_id)
+        unmatched = self._collect_stale_input()
+        for servo_id in sorted(self._timed_out_ids):
+            if self._status_packet_from(unmatched, servo_id):
+                raise self._late(servo_id)
         reset = getattr(self.port, "reset_input_buffer", None)
         if callable(reset):
             reset()

@@ -363,7 +363,8 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
     if not frames_t:
         raise RecordingError(f"{path}: no goal-position frames to check (sync writes to address {goal_addr}); "
                              "was this recorded from a walk?")
-    timing, timing_issues = _frame_timing(config.gait.rate_hz, np.array(timing_t), np.array(timing_line, dtype=int))
+    rate_hz = float(header.get("rate_hz", config.gait.rate_hz))  # a recording made at --rate R carries R
+    timing, timing_issues = _frame_timing(rate_hz, np.array(timing_t), np.array(timing_line, dtype=int))
     issues += timing_issues
 
     health = health_report(packets, wire.framing_for(config.bus.backend, config.bus.protocol), models,

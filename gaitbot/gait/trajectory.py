@@ -19,7 +19,9 @@ from pathlib import Path
 import numpy as np
 
 from gaitbot.errors import UserError
+from gaitbot.fields import read_user_file
 from gaitbot.gait.joints import LEG_JOINTS, PITCH_JOINTS, canonical, is_leg_joint
+from gaitbot.gait.npz_file import NpzProblem, numeric, read_npz
 
 FORMAT_VERSION = 2
 VERSION_LINE = f"# gaitbot trajectory {FORMAT_VERSION}"
@@ -138,7 +140,7 @@ class Trajectory:
     def load(cls, path: str | Path) -> "Trajectory":
         """Read a ``.csv`` or ``.npz`` trajectory (format 1 or 2); raise TrajectoryFileError with a one-line reason."""
         path = Path(path)
-        if not path.is_file():
+        if not path.exists():
             raise TrajectoryFileError(f"{path}: no such file")
         if path.suffix == ".npz":
             return _load_npz(path)
@@ -150,6 +152,12 @@ class Trajectory:
 def sagittal_to_world(root_xz_m: np.ndarray) -> np.ndarray:
     """(N, 2) sagittal-plane points (forward, up) -> (N, 3) world points (x, y = 0, z)."""
     return np.column_stack([root_xz_m[:, 0], np.zeros(len(root_xz_m)), root_xz_m[:, 1]])
+
+
+#: Values a trajectory file may hold (far beyond any walk; beyond them arithmetic on them overflows).
+MAX_TIME_S = 1e7
+MAX_ANGLE_DEG = 3600.0
+MAX_ROOT_M = 1e4
 
 
 class CsvTrajectoryWriter:
@@ -195,6 +203,10 @@ def _from_table(path: Path, t: np.ndarray, angles_deg: np.ndarray, root: np.ndar
     for name, values in named:
         if values is not None and not np.all(np.isfinite(values)):
             raise TrajectoryFileError(f"{path}: column {name} holds a value that is not a finite number")
+    for name, values, bound, unit in (("t_s", t, MAX_TIME_S, "s"), ("joint angles", angles_deg, MAX_ANGLE_DEG, "deg"),
+                                      ("root", root, MAX_ROOT_M, "m")):
+        if np.any(np.abs(values) > bound):
+            raise TrajectoryFileError(f"{path}: column {name} holds a value beyond +-{bound:g} {unit}")
     if np.any(np.diff(t) <= 0):
         i = int(np.argmax(np.diff(t) <= 0)) + 1
         raise TrajectoryFileError(f"{path}: t_s must increase, but row {i + 1} has t_s={t[i]!r} after {t[i - 1]!r}")
@@ -259,10 +271,15 @@ def _read_version_line(path: Path, first: str) -> int | None:
 
 def _load_csv(path: Path) -> Trajectory:
     try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TrajectoryFileError(f"{path}: cannot read ({exc})") from None
-    rows = list(csv.reader(io.StringIO(text)))
+        text = read_user_file(path).decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise TrajectoryFileError(f"{path}: cannot read (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
+    except OSError as exc:
+        raise TrajectoryFileError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    try:
+        rows = list(csv.reader(io.StringIO(text)))
+    except csv.Error as exc:  # a cell over the csv module's field limit, a NUL byte ...
+        raise TrajectoryFileError(f"{path}: not a CSV table ({exc})") from None
     if rows and rows[0] and rows[0][0].startswith("#"):
         version = _read_version_line(path, ",".join(rows[0]).strip())
         rows = rows[1:]
@@ -297,36 +314,54 @@ def _load_csv(path: Path) -> Trajectory:
 
 def _load_npz(path: Path) -> Trajectory:
     try:
-        with np.load(path, allow_pickle=False) as z:
-            missing = [k for k in ("t_s", "angles_deg", "root_m") if k not in z.files]
-            if missing:
-                raise TrajectoryFileError(f"{path}: missing array {missing[0]!r} (needs t_s, angles_deg, root_m)")
-            t, ang, root = z["t_s"], z["angles_deg"], z["root_m"]
-            raw = z["heel_strikes"] if "heel_strikes" in z.files else np.zeros((0, 4))
-            names = tuple(str(n) for n in z["joints"].reshape(-1)) if "joints" in z.files else PITCH_JOINTS
-            version = int(z["format_version"]) if "format_version" in z.files else 1
-            torso = z["torso_rpy_deg"] if "torso_rpy_deg" in z.files else None
-    except TrajectoryFileError:
-        raise
-    except Exception as exc:  # zipfile/ValueError/EOFError on a truncated or foreign file
-        raise TrajectoryFileError(f"{path}: not a readable .npz trajectory ({type(exc).__name__}: {exc})") from None
-    if version not in (1, FORMAT_VERSION):
-        raise TrajectoryFileError(f"{path}: trajectory format {version} is not one this gaitbot reads (1 or 2)")
-    unknown = [n for n in names if not is_leg_joint(n)]
-    if unknown or len(set(names)) != len(names) or (version == 1 and names != PITCH_JOINTS):
-        raise TrajectoryFileError(f"{path}: array joints {list(names)[:12]} must name distinct leg joints")
-    _require_pitch_joints(path, names, lambda name: f"joint {name}")
-    width = 2 if version == 1 else 3
-    if (ang.ndim != 2 or ang.shape[1] != len(names) or ang.shape[0] != len(t) or root.shape != (len(t), width)
-            or (torso is not None and torso.shape != (len(t), 3))):
+        arrays = read_npz(path)
+        missing = [k for k in ("t_s", "angles_deg", "root_m") if k not in arrays]
+        if missing:
+            raise TrajectoryFileError(f"{path}: missing array {missing[0]!r} (needs t_s, angles_deg, root_m)")
+        version = int(numeric(arrays, "format_version", 0)) if "format_version" in arrays else 1
+        if version not in (1, FORMAT_VERSION):
+            raise TrajectoryFileError(f"{path}: trajectory format {version} is not one this gaitbot reads (1 or 2)")
+        names = _npz_joint_names(path, arrays, version)
+        t = numeric(arrays, "t_s", 1)
+        ang = numeric(arrays, "angles_deg", 2, columns=len(names))
+        root = numeric(arrays, "root_m", 2, columns=2 if version == 1 else 3)
+        torso = numeric(arrays, "torso_rpy_deg", 2, columns=3) if "torso_rpy_deg" in arrays else None
+        width = 3 if version == 1 else 4
+        raw = (numeric(arrays, "heel_strikes", 2, columns=width, finite=False) if "heel_strikes" in arrays
+               else np.zeros((0, width)))
+    except OSError as exc:
+        raise TrajectoryFileError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    except NpzProblem as exc:
+        raise TrajectoryFileError(f"{path}: {exc}") from None
+    if ang.shape[0] != len(t) or root.shape[0] != len(t) or (torso is not None and torso.shape[0] != len(t)):
         raise TrajectoryFileError(f"{path}: arrays have inconsistent shapes t_s{t.shape} angles_deg{ang.shape} "
                                   f"root_m{root.shape}")
+    if not np.all(np.isfinite(raw[:, :3])):
+        raise TrajectoryFileError(f"{path}: array 'heel_strikes' holds a time, leg or x that is not a finite number")
+    if len(raw) and not np.isin(raw[:, 1], (0.0, 1.0)).all():
+        raise TrajectoryFileError(f"{path}: array 'heel_strikes': column 2 (the leg) must be 0 (left) or 1 (right)")
     if version == 1:
         root = sagittal_to_world(root)
-    rows = raw.reshape(-1, raw.shape[-1] if raw.ndim == 2 else 3)
     strikes = [HeelStrike(float(r[0]), "left" if int(r[1]) == 0 else "right", float(r[2]),
-                          None if len(r) < 4 or np.isnan(r[3]) else float(r[3])) for r in rows]
+                          None if len(r) < 4 or not np.isfinite(r[3]) else float(r[3])) for r in raw]
     return _from_table(path, t, ang, root, strikes, names, torso)
+
+
+def _npz_joint_names(path: Path, arrays: dict, version: int) -> tuple[str, ...]:
+    """The ``joints`` array: distinct leg joint names including the pitch joints (format 1: the six)."""
+    if "joints" not in arrays:
+        if version == 1:
+            return PITCH_JOINTS
+        raise TrajectoryFileError(f"{path}: missing array 'joints' (the names of the angles' columns)")
+    raw = arrays["joints"]
+    if raw.dtype.kind != "U" or raw.ndim != 1:
+        raise TrajectoryFileError(f"{path}: array 'joints' must be a list of joint names, not {raw.dtype} {raw.shape}")
+    names = tuple(str(n) for n in raw)
+    unknown = [n for n in names if not is_leg_joint(n)]
+    if unknown or len(set(names)) != len(names) or (version == 1 and names != PITCH_JOINTS):
+        raise TrajectoryFileError(f"{path}: array 'joints' must name distinct leg joints, got {list(names)[:12]}")
+    _require_pitch_joints(path, names, lambda name: f"joint {name}")
+    return names
 
 
 def load_fast(path: str | Path) -> Trajectory:
@@ -359,6 +394,8 @@ def refuse_truncated_csv(path: str | Path) -> None:
     """A ``.csv`` whose last line has no newline is taken as truncated: ``generate`` always ends its files
     with one, and a row cut inside its last number would still parse."""
     path = Path(path)
+    if not path.is_file():
+        return  # Trajectory.load says what it is instead (missing, a directory, a FIFO, a device)
     try:
         with open(path, "rb") as f:
             f.seek(0, 2)

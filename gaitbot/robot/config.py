@@ -31,11 +31,13 @@ from gaitbot.fields import FieldError, Fields, kind, read_toml
 from gaitbot.gait.balance.settings import LIMITS as BALANCE_LIMITS
 from gaitbot.gait.balance.settings import BalanceSettings
 from gaitbot.gait.body import LEG_LINKS, BodyGeometry, BodyModel, LinkInertial, inertia_matrix
+from gaitbot.gait.geometry import LegGeometry
 from gaitbot.gait.joints import LEG_JOINTS, PITCH_JOINTS, PITCH_KINDS, canonical, is_leg_joint, mirror, split_joint
+from gaitbot.gait.walker import WalkSettings, make_context
 from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
 from gaitbot.robot.gains import GainError, gain_for_error
 from gaitbot.robot.health import HealthSettings, read_health
-from gaitbot.servos import BACKENDS, dynamixel, feetech, max_servo_id
+from gaitbot.servos import BACKENDS, dynamixel, feetech, max_servo_id, vendor
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
 
 DEFAULT_ROBOT = "xl430-biped"
@@ -313,6 +315,23 @@ def load_robot_config(path: str | Path, *, extra_checks: Iterable[ConfigCheck] =
     return config
 
 
+#: Bounds of every size a config can ask for (value ranges, both ends included; the shipped robots sit
+#: well inside them). Beyond them a field is refused on load, before any work: a cycle of 1e9 s or a
+#: step of 1e-9 m would otherwise ask for gigabytes of frames (docs/robot-config.md).
+LIMB_RANGE_M = (0.0, 2.0, "m")
+CYCLE_RANGE_S = (0.2, 10.0, "s")
+STEP_RANGE_M = (0.005, 2.0, "m")
+CLEARANCE_RANGE_M = (0.0, 0.5, "m")
+#: Frame rates a walk may stream at: below 10 Hz each goal is a jump a position servo makes at full
+#: speed; above 200 Hz no read-back fits in a frame (gaitbot.stream.readback).
+RATE_RANGE_HZ = (10.0, 200.0, "Hz")
+ANGLE_RANGE_DEG = (-360.0, 360.0, "deg")
+VELOCITY_RANGE_DPS = (0.0, 100_000.0, "deg/s")
+ACCELERATION_RANGE_DPS2 = (0.0, 10_000_000.0, "deg/s^2")
+MASS_RANGE_KG = (0.0, 1000.0, "kg")
+#: The swing foot's clearance may be at most this share of the leg (thigh + shank).
+CLEARANCE_SHARE_OF_LEG = 0.25
+
 TORSO_HEIGHT_LEGS = 0.6
 """A planar robot's torso (``[mass] torso_kg``) is a box this many leg lengths tall standing on the hips."""
 MASS_TOLERANCE_KG = 1e-4
@@ -354,10 +373,12 @@ class _Reader(Fields):
         mass = self.mass(self.optional_table(data, "mass", "mass", _MASS_KEYS), links)
         servo = self.servo(self.optional_table(data, "servo", "servo", _SERVO_KEYS))
         self.gains_settable(joints, servo)
+        self.walkable(geometry, gait)
         terrain = None
         if "terrain" in data:
             t = self.table(data, "terrain", "terrain", _TERRAIN_KEYS)
-            terrain = TerrainReach(*(self.number(t, key, "terrain", non_negative=True) for key in _TERRAIN_KEYS))
+            terrain = TerrainReach(*(self.number(t, key, "terrain", non_negative=True, within=LIMB_RANGE_M)
+                                     for key in _TERRAIN_KEYS))
         health = read_health(self, data, joints)
         balance = self.balance(self.optional_table(data, "balance", "balance", BalanceSettings.field_names()))
         config = RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
@@ -366,6 +387,25 @@ class _Reader(Fields):
         self.three_d_checks(config)
         return config
 
+    def walkable(self, geometry: Geometry, gait: GaitSettings) -> None:
+        """Sizes that only make sense together: the swing clearance against the leg, the longest step
+        against what the leg reaches in its cycle (refused, not silently clipped)."""
+        leg_m = geometry.thigh_m + geometry.shank_m
+        if gait.clearance_m > CLEARANCE_SHARE_OF_LEG * leg_m:
+            raise self.fail("gait.clearance_m", f"{gait.clearance_m:g} m is more than "
+                                                f"{CLEARANCE_SHARE_OF_LEG:g} of the leg (thigh_m + shank_m = "
+                                                f"{leg_m:g} m): at most {CLEARANCE_SHARE_OF_LEG * leg_m:.3g} m")
+        leg = LegGeometry(thigh=geometry.thigh_m, shank=geometry.shank_m, foot=geometry.foot_m,
+                          hip_width=geometry.hip_width_m, ankle_height=geometry.ankle_height_m,
+                          heel_back=geometry.heel_back_m)
+        try:
+            reach_m = make_context(leg, WalkSettings(gait.cycle_s, gait.rate_hz, gait.clearance_m)).inverse.max_step_length
+        except (ValueError, ArithmeticError) as exc:
+            raise self.fail("geometry", f"this leg cannot walk with cycle_s {gait.cycle_s:g} s ({exc})") from None
+        if gait.max_step_m > reach_m * (1 + 1e-9):
+            raise self.fail("gait.max_step_m", f"{gait.max_step_m:g} m is longer than this leg reaches in a "
+                                               f"{gait.cycle_s:g} s cycle ({reach_m:.4g} m); at most {reach_m:.4g} m")
+
     def mass(self, t: dict, links) -> MassSettings:
         """The four planar segments, or with ``[links.*]`` only ``total_kg``, which must add up."""
         if links is not None:
@@ -373,14 +413,15 @@ class _Reader(Fields):
                 if key in t:
                     raise self.fail(f"mass.{key}", "give link masses in [links.*] or segment masses in [mass], "
                                                    "not both")
-            total = self.number(t, "total_kg", "mass", positive=True)
+            total = self.number(t, "total_kg", "mass", positive=True, within=MASS_RANGE_KG)
             summed = sum(link.mass_kg * (1 if name == "torso" else 2) for name, link in links)
             if abs(summed - total) > MASS_TOLERANCE_KG:
                 raise self.fail("mass.total_kg", f"{total:g} kg, but torso + 2 x the leg links add up to "
                                                  f"{summed:.6f} kg (a mass table that does not add up)")
             return MassSettings()
         defaults = MassSettings()
-        mass = MassSettings(**{k: self.number(t, k, "mass", positive=True, default=getattr(defaults, k))
+        mass = MassSettings(**{k: self.number(t, k, "mass", positive=True, default=getattr(defaults, k),
+                                              within=MASS_RANGE_KG)
                                for k in _MASS_KEYS[:4]})
         if "total_kg" in t:
             total = self.number(t, "total_kg", "mass", positive=True)
@@ -396,7 +437,7 @@ class _Reader(Fields):
         for name in _LINK_NAMES:
             f = f"links.{name}"
             t = self.table(tables, name, f, _LINK_KEYS)
-            mass = self.number(t, "mass_kg", f, positive=name == "torso", non_negative=True)
+            mass = self.number(t, "mass_kg", f, positive=name == "torso", non_negative=True, within=MASS_RANGE_KG)
             com = self.vector(t, "com_m", f, 3, "[x, y, z] in metres")
             inertia = inertia_matrix(*self.vector(t, "inertia_kg_m2", f, 6, "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] in kg m^2"))
             moments = np.linalg.eigvalsh(inertia)
@@ -463,31 +504,38 @@ class _Reader(Fields):
 
     def geometry(self, t: dict) -> Geometry:
         f = "geometry"
+        length = LIMB_RANGE_M
         geometry = Geometry(
-            thigh_m=self.number(t, "thigh_m", f, positive=True),
-            shank_m=self.number(t, "shank_m", f, positive=True),
-            foot_m=self.number(t, "foot_m", f, positive=True),
-            hip_width_m=self.number(t, "hip_width_m", f, positive=True),
-            ankle_height_m=self.number(t, "ankle_height_m", f, non_negative=True, default=0.0),
-            heel_back_m=self.number(t, "heel_back_m", f, non_negative=True, default=0.0),
-            foot_width_m=self.number(t, "foot_width_m", f, positive=True) if "foot_width_m" in t else None,
-            sole_outward_m=self.number(t, "sole_outward_m", f, default=0.0),
-            hip_below_root_m=self.number(t, "hip_below_root_m", f, non_negative=True, default=0.0),
+            thigh_m=self.number(t, "thigh_m", f, positive=True, within=length),
+            shank_m=self.number(t, "shank_m", f, positive=True, within=length),
+            foot_m=self.number(t, "foot_m", f, positive=True, within=length),
+            hip_width_m=self.number(t, "hip_width_m", f, positive=True, within=length),
+            ankle_height_m=self.number(t, "ankle_height_m", f, non_negative=True, default=0.0, within=length),
+            heel_back_m=self.number(t, "heel_back_m", f, non_negative=True, default=0.0, within=length),
+            foot_width_m=self.number(t, "foot_width_m", f, positive=True, within=length) if "foot_width_m" in t else None,
+            sole_outward_m=self.number(t, "sole_outward_m", f, default=0.0, within=(-1.0, 1.0, "m")),
+            hip_below_root_m=self.number(t, "hip_below_root_m", f, non_negative=True, default=0.0, within=length),
         )
         if geometry.foot_width_m is not None and geometry.foot_width_m <= 0:
             raise self.fail("geometry.foot_width_m", f"must be a positive number, got {geometry.foot_width_m}")
         if geometry.heel_back_m >= geometry.foot_m:
             raise self.fail("geometry.heel_back_m", f"{geometry.heel_back_m} must be shorter than foot_m "
                                                     f"{geometry.foot_m} (the heel is behind the ankle, the toe ahead)")
+        leg_m = geometry.thigh_m + geometry.shank_m
+        for key in ("foot_m", "ankle_height_m", "hip_width_m"):
+            value = getattr(geometry, key)
+            if value > leg_m:
+                raise self.fail(f"geometry.{key}", f"{value:g} m is longer than the leg (thigh_m + shank_m = "
+                                                   f"{leg_m:g} m); at most {leg_m:g} m")
         return geometry
 
     def gait(self, t: dict) -> GaitSettings:
         f = "gait"
         return GaitSettings(
-            cycle_s=self.number(t, "cycle_s", f, positive=True),
-            max_step_m=self.number(t, "max_step_m", f, positive=True),
-            clearance_m=self.number(t, "clearance_m", f, positive=True),
-            rate_hz=self.number(t, "rate_hz", f, positive=True),
+            cycle_s=self.number(t, "cycle_s", f, positive=True, within=CYCLE_RANGE_S),
+            max_step_m=self.number(t, "max_step_m", f, positive=True, within=STEP_RANGE_M),
+            clearance_m=self.number(t, "clearance_m", f, positive=True, within=CLEARANCE_RANGE_M),
+            rate_hz=self.number(t, "rate_hz", f, positive=True, within=RATE_RANGE_HZ),
         )
 
     def bus(self, t: dict) -> BusSettings:
@@ -503,9 +551,12 @@ class _Reader(Fields):
                 raise self.fail("bus.protocol", f"unknown Dynamixel protocol {protocol} (allowed: {allowed})")
         # Feetech servos speak one protocol; a protocol key there is accepted and ignored (always 1.0).
         port = self.string(t, "port", f, "a serial port name, e.g. '/dev/ttyUSB0' or 'COM3'")
-        baudrate = self.integer(t, "baudrate", f, "a positive integer (bits per second)")
-        if baudrate <= 0:
-            raise self.fail("bus.baudrate", f"must be a positive integer (bits per second), got {baudrate}")
+        rates = vendor(backend).SDK_BAUDRATES
+        allowed_rates = ", ".join(str(r) for r in rates)
+        baudrate = self.integer(t, "baudrate", f, f"a baud rate the {backend} SDK sets: {allowed_rates}")
+        if baudrate not in rates:
+            raise self.fail("bus.baudrate", f"{baudrate} is not a baud rate the {backend} SDK can set "
+                                            f"(allowed: {allowed_rates})")
         torque_off = self.boolean(t, "torque_off_on_exit", f, default=False)
         return BusSettings(backend=backend, protocol=protocol, port=port, baudrate=baudrate,
                            torque_off_on_exit=torque_off)
@@ -579,8 +630,8 @@ class _Reader(Fields):
         if direction not in (1, -1):
             raise self.fail(f"{f}.direction", f"must be 1 or -1 (-1 for a mirror-mounted servo), got {direction}")
 
-        min_deg = self.number(t, "min_deg", f)
-        max_deg = self.number(t, "max_deg", f)
+        min_deg = self.number(t, "min_deg", f, within=ANGLE_RANGE_DEG)
+        max_deg = self.number(t, "max_deg", f, within=ANGLE_RANGE_DEG)
         if min_deg > max_deg:
             raise self.fail(f"{f}.min_deg", f"{min_deg} is above max_deg {max_deg}")
         for key, angle_deg in (("min_deg", min_deg), ("max_deg", max_deg)):
@@ -588,15 +639,16 @@ class _Reader(Fields):
             if problem:
                 raise self.fail(f"{f}.{key}", problem)
 
-        max_velocity_dps = self.number(t, "max_velocity_dps", f, positive=True)
-        max_acceleration_dps2 = self.number(t, "max_acceleration_dps2", f, positive=True)
+        max_velocity_dps = self.number(t, "max_velocity_dps", f, positive=True, within=VELOCITY_RANGE_DPS)
+        max_acceleration_dps2 = self.number(t, "max_acceleration_dps2", f, positive=True,
+                                            within=ACCELERATION_RANGE_DPS2)
 
         hold_deg: float | None = None
         if "hold_deg" in t:
             if walking:
                 raise self.fail(f"{f}.hold_deg", "only non-walking joints (roll and yaw) may be held: the walk "
                                                  "moves every hip, knee and ankle pitch joint")
-            hold_deg = self.number(t, "hold_deg", f)
+            hold_deg = self.number(t, "hold_deg", f, within=ANGLE_RANGE_DEG)
             if not min_deg <= hold_deg <= max_deg:
                 raise self.fail(f"{f}.hold_deg", f"{hold_deg} is outside the joint's limits {min_deg}..{max_deg} deg")
 

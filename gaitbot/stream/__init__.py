@@ -2,15 +2,23 @@
 
 ``clock`` (real and virtual time), ``pacing`` (frames on absolute deadlines, their statistics),
 ``ramps`` (rest-to-rest ramps and the braking stop), ``session`` (the walk session and its safe
-stop), ``record`` (the record-by-hand session), ``signals`` (SIGTERM as an exception).
+stop), ``record`` (the record-by-hand session), ``signals`` (SIGTERM as an exception, repeated signals), ``readback`` (the per-frame read-back).
+
+Names are imported when first used, so ``gaitbot.stream.signals`` (which the command line installs
+before anything heavy is imported) stays light.
 """
 
-from gaitbot.stream.clock import Clock, MonotonicClock, VirtualClock
-from gaitbot.stream.pacing import LATE_THRESHOLD_S, StreamStats, Streamer, paced_deadlines
-from gaitbot.stream.ramps import brake_ticks, ramp_ticks, stop_ticks
-from gaitbot.stream.record import RecordResult, record_session
-from gaitbot.stream.session import EXIT_CODES, MissingServosError, SessionResult, prepare, walk_session, write_settings
-from gaitbot.stream.signals import Terminated, sigterm_raises_terminated
+import importlib
+
+_NAMES = {
+    "Clock": "clock", "MonotonicClock": "clock", "VirtualClock": "clock",
+    "LATE_THRESHOLD_S": "pacing", "StreamStats": "pacing", "Streamer": "pacing", "paced_deadlines": "pacing",
+    "brake_ticks": "ramps", "ramp_ticks": "ramps", "stop_ticks": "ramps",
+    "RecordResult": "record", "record_session": "record",
+    "EXIT_CODES": "session", "MissingServosError": "session", "SessionResult": "session", "prepare": "session",
+    "walk_session": "session", "write_settings": "session",
+    "Terminated": "signals", "sigterm_raises_terminated": "signals",
+}
 
 __all__ = [
     "Clock", "MonotonicClock", "VirtualClock", "ramp_ticks", "brake_ticks", "stop_ticks",
@@ -18,3 +26,15 @@ __all__ = [
     "sigterm_raises_terminated", "SessionResult", "walk_session", "record_session", "RecordResult",
     "LATE_THRESHOLD_S", "EXIT_CODES",
 ]
+
+
+def __getattr__(name: str):
+    if name in _NAMES:
+        value = getattr(importlib.import_module(f"gaitbot.stream.{_NAMES[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'gaitbot.stream' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -14,9 +14,9 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-from gaitbot.bus.base import BusError
+from gaitbot.bus.base import BusError, ReadBack
 from gaitbot.robot.health import health_thresholds
-from gaitbot.servos.health import HealthReading, HealthThresholds, servo_limits
+from gaitbot.servos.health import HealthBlock, HealthReading, HealthThresholds, decode_health, health_block, servo_limits
 
 
 class ServoHealthStop(BusError):
@@ -49,8 +49,9 @@ class HealthMonitor:
 
     def __init__(self, thresholds: Mapping[int, HealthThresholds], names: Mapping[int, str] | None = None,
                  models: Mapping[int, str] | None = None, on_warning: Callable[[str], None] | None = None,
-                 clock: Callable[[], float] | None = None) -> None:
+                 clock: Callable[[], float] | None = None, blocks: Mapping[int, HealthBlock] | None = None) -> None:
         self.thresholds = dict(thresholds)
+        self.blocks = dict(blocks or {})  # servo id -> the registers its read-back reads (servos.health)
         self.names = dict(names or {})
         self.models = dict(models or {})
         self.on_warning = on_warning
@@ -67,7 +68,14 @@ class HealthMonitor:
                   clock: Callable[[], float] | None = None) -> "HealthMonitor":
         """The monitor of a robot config's servos: its thresholds (models' defaults, its ``[health]``)."""
         return cls(health_thresholds(config), {j.id: j.name for j in config.joints},
-                   {j.id: j.model.name for j in config.joints}, on_warning, clock)
+                   {j.id: j.model.name for j in config.joints}, on_warning, clock,
+                   {j.id: health_block(j.model) for j in config.joints})
+
+    def observe_read_back(self, answer: ReadBack) -> None:
+        """An answered per-frame read-back (gaitbot.stream.readback) whose data is this servo's health block."""
+        block = self.blocks.get(answer.servo_id)
+        if block is not None and answer.data is not None and len(answer.data) >= block.length:
+            self.observe(decode_health(block, answer.servo_id, answer.data[:block.length]))
 
     def label(self, servo_id: int) -> str:
         name = self.names.get(servo_id)

@@ -145,9 +145,10 @@ class Streamer:
     on_frame(k, stats) is called after frame k went out, in the loop's own time: keep it
     to reading the cheap fields of :class:`StreamStats` and printing now and then.
 
-    monitor() is called right after each write, inside the frame's bus time (``bus_call_s``
-    covers both): walk_session reads the servos back there, so that a servo that stops
-    answering or reports a fault ends the walk within a frame or two. It raises to stop.
+    monitor(deadline_s) is called right after each write with that frame's deadline, inside the
+    frame's bus time (``bus_call_s`` covers both): walk_session reads a servo back there within
+    what is left of the frame (gaitbot.stream.readback), so that a servo that stops answering or
+    reports a fault ends the walk within a few frames. It raises to stop.
 
     After ``run`` returns or raises, ``stats`` holds the figures so far,
     ``last_sent_ticks`` the last frame whose write was started (None before the first) and
@@ -161,7 +162,7 @@ class Streamer:
                  late_threshold_s: float = LATE_THRESHOLD_S,
                  min_frame_interval_s: float | None = None,
                  cpu_time_s: Callable[[], float] = time.process_time,
-                 monitor: Callable[[], None] | None = None) -> None:
+                 monitor: Callable[[float], None] | None = None) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be > 0, got {period_s}")
         self.bus = bus
@@ -178,13 +179,17 @@ class Streamer:
         self.stats = StreamStats(period_s=self.period_s, late_threshold_s=late_threshold_s)
         self.last_sent_ticks: np.ndarray | None = None
         self.previous_sent_ticks: np.ndarray | None = None
+        self.last_send_s: float | None = None
 
-    def run(self, frames: ArrayLike, start_s: float | None = None) -> StreamStats:
+    def run(self, frames: ArrayLike, start_s: float | None = None, previous_send_s: float | None = None) -> StreamStats:
         """Stream ``frames`` (N, len(ids)) of int ticks; return their timing.
 
         ``start_s`` is the first frame's deadline (default: now); a session passes the deadline
         after its previous run so consecutive runs keep one period apart on one absolute grid.
-        ``next_deadline_s`` holds the deadline after the last frame sent (also when interrupted)."""
+        ``next_deadline_s`` holds the deadline after the last frame sent (also when interrupted).
+        ``previous_send_s``: when the frame before this run went out (a session's previous run), so the
+        pacing rule holds across runs too: a stop ramp never follows a late walk frame by less than
+        ``min_frame_interval_s``. ``last_send_s`` holds the send time of this run's last frame."""
         frames = as_tick_frames(frames, len(self.ids))
         count = frames.shape[0]
         stats = StreamStats(period_s=self.period_s, late_threshold_s=self.late_threshold_s,
@@ -195,17 +200,28 @@ class Streamer:
         start_s = clock.now() if start_s is None else start_s
         self.next_deadline_s = start_s
         try:
-            ticks = paced_deadlines(clock, self.period_s, start_s, self.min_frame_interval_s)
+            earliest_s = start_s if previous_send_s is None else max(start_s, previous_send_s + self.min_frame_interval_s)
+            ticks = paced_deadlines(clock, self.period_s, start_s, self.min_frame_interval_s, earliest_s)
+            last_write_s = previous_send_s
+            min_interval_s = self.min_frame_interval_s
             for _, (k, deadline_s, send_s) in zip(range(count), ticks):
                 work_cpu_start = cpu()
-                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frames[k]
                 # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
                 # time: converting a whole one-hour walk up front would take ~100 MB.
-                bus.write_goal_ticks(dict(zip(ids, frames[k].tolist())))
-                if monitor is not None:
-                    monitor()
-                done_s = clock.now()
+                goals = dict(zip(ids, frames[k].tolist()))
+                # The pacing rule on the wire itself: had the host paused between the previous frame's
+                # start and its write, this write still waits the minimum interval after that one.
+                if last_write_s is not None and clock.now() < last_write_s + min_interval_s:
+                    clock.sleep_until(last_write_s + min_interval_s)
+                last_write_s = self.last_send_s = clock.now()
+                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frames[k]
+                bus.write_goal_ticks(goals)
+                # The grid moves on as soon as the goals went out: whatever the read-back raises, the
+                # next frame sent (a stop ramp's first) is due one period after this one, not at once.
                 self.next_deadline_s = deadline_s + self.period_s
+                if monitor is not None:
+                    monitor(deadline_s)
+                done_s = clock.now()
                 stats._record(send_s - deadline_s, done_s - send_s)
                 stats.wall_s = done_s - start_s
                 if self.on_frame is not None:
@@ -216,14 +232,16 @@ class Streamer:
         return stats
 
 
-def paced_deadlines(clock: Clock, period_s: float, start_s: float, min_interval_s: float):
+def paced_deadlines(clock: Clock, period_s: float, start_s: float, min_interval_s: float,
+                    earliest_s: float | None = None):
     """The pacing rule of the module docstring, for any per-frame work (sending goals, reading positions).
 
     Yields ``(k, deadline_s, start_s_of_work)`` for k = 0, 1, ...: waits until frame k's absolute
     deadline ``start_s + k * period_s`` but never less than ``min_interval_s`` after the previous
     frame's work started, then reports the time the work starts. Deadlines are never re-anchored;
-    nothing is skipped. Stop iterating to stop (the generator sleeps only when asked for a frame)."""
-    earliest_s = start_s
+    nothing is skipped. Stop iterating to stop (the generator sleeps only when asked for a frame).
+    ``earliest_s``: the first frame's work starts no sooner (default ``start_s``)."""
+    earliest_s = start_s if earliest_s is None else earliest_s
     k = 0
     while True:
         deadline_s = start_s + k * period_s

@@ -14,11 +14,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite, ServoTimeout
+from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite
+from gaitbot.bus.log import RecordingFailed
 from gaitbot.stream.clock import Clock, MonotonicClock
 from gaitbot.stream.health import HealthMonitor, ServoHealthStop
 from gaitbot.stream.pacing import StreamStats, Streamer, as_tick_frames
 from gaitbot.stream.ramps import ramp_ticks, stop_ticks
+from gaitbot.stream.readback import ReadBackMonitor
 from gaitbot.stream.signals import Terminated, install_sigterm_handler, restore_sigterm_handler
 
 #: Exit codes by outcome, the shell's conventions (128 + SIGINT, 128 + SIGTERM).
@@ -102,6 +104,8 @@ class SessionResult:
                 "terminated": "Walk terminated (SIGTERM)", "bus_error": "Walk stopped by a bus error",
                 "health_stop": "Walk stopped to protect a servo"}
         parts = [head.get(self.outcome, self.outcome)]
+        if isinstance(self.error, RecordingFailed):
+            parts = ["Walk stopped because the recording failed (the serial port is fine)"]
         if self.error is not None:
             parts.append(f"error: {self.error}")
         parts.extend(self.notes)
@@ -127,13 +131,14 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
     reach the servos.
 
     ``monitor_servos``: after every frame of the start ramp, the walk and the final ramp one servo is
-    read back, each in turn, so a servo that stops answering or reports error bits ends the walk within
-    ``len(ids)`` frames plus the bus's bounded retries; the safe stop ramp is not read back (it must
-    reach the healthy servos whatever the faulty one does). ``handle_sigterm``: SIGTERM raises
+    read back within what is left of that frame (gaitbot.stream.readback: never waited on, never
+    retried inside a frame), so a servo that stops answering or reports error bits ends the walk
+    within ``len(ids)`` + READ_BACK_MISSES frames; the safe stop ramp is not read back (it must reach
+    the healthy servos whatever the faulty one does). ``handle_sigterm``: SIGTERM raises
     :class:`~gaitbot.stream.signals.Terminated` (main thread only; the old handler is restored).
 
     ``health``: that read-back reads the servo's whole health block instead (position, temperature,
-    voltage, load: one READ, ``Bus.read_health``) and hands it to the monitor, which warns or stops the
+    voltage, load: the same one READ, ``Bus.set_read_back_blocks``) and hands it to the monitor, which warns or stops the
     walk (outcome "health_stop", the safe stop of a bus fault, exit 1); every servo is also read once
     before torque goes on, so a robot already too hot or on a flat battery does not start.
     """
@@ -151,22 +156,16 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
         return stop_ticks(previous_ticks, last_ticks, stand, max_velocity_ticks_per_s, max_accel_ticks_per_s2,
                           period_s)
 
-    next_checked = [0]
-
-    def check_servos() -> None:
-        """Read one servo back per frame, in turn: each servo is checked every len(ids) frames, and
-        the frame's bus time grows by one status packet, not by len(ids) of them (protocols without
-        sync read would otherwise ask every servo on its own every frame)."""
-        servo_id = ids[next_checked[0] % len(ids)]
-        next_checked[0] += 1
-        if health is not None:
-            health.observe(bus.read_health(servo_id))
-        elif servo_id not in bus.read_present_ticks([servo_id]):
-            raise ServoTimeout(f"servo {servo_id} stopped answering reads during the walk", servo_id=servo_id)
+    read_back = None
+    if monitor_servos:
+        on_answer = None
+        if health is not None:  # the read-back reads each servo's health block and the monitor judges it
+            bus.set_read_back_blocks({i: (b.address, b.length) for i, b in health.blocks.items()})
+            on_answer = health.observe_read_back
+        read_back = ReadBackMonitor(bus, ids, clock, period_s, on_answer=on_answer)
 
     def streamer(callback=None, monitored: bool = False) -> Streamer:
-        monitor = check_servos if (monitored and monitor_servos) else None
-        return Streamer(bus, ids, period_s, clock, callback, monitor=monitor)
+        return Streamer(bus, ids, period_s, clock, callback, monitor=read_back if monitored else None)
 
     old_handler = install_sigterm_handler() if handle_sigterm else None
     state = _SessionState()
@@ -184,6 +183,7 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             first_sent_s = clock.now()
             bus.write_goal_ticks(dict(zip(ids, first_goal.tolist())))
             state.last_sent = first_goal
+            state.last_send_s = first_sent_s
             state.torque_on = True  # before the call: a torque-on that fails halfway still gets its torque-off
             bus.set_torque(ids, True)
             state.next_deadline_s = first_sent_s + period_s
@@ -206,6 +206,12 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
                                    "the servos hold their last goal")
             else:
                 state.safe_stop(streamer, stop)
+                explain = getattr(bus, "explain_status_error", None)
+                if callable(explain):  # the robot is safe now: time to read what the fault was
+                    try:
+                        error = explain(exc)
+                    except (KeyboardInterrupt, Terminated):
+                        pass
         except Exception:
             state.safe_stop(streamer, stop)
             state.finish(bus, ids, torque_off_on_exit)
@@ -236,12 +242,14 @@ class _SessionState:
         self.walk_stats: StreamStats | None = None
         self.notes: list[str] = []
         self.next_deadline_s: float | None = None  # keeps consecutive runs on one frame grid
+        self.last_send_s: float | None = None  # when the last frame went out: the pacing rule across runs
 
     def run(self, streamer: Streamer, frames: np.ndarray, is_walk: bool = False) -> None:
         try:
-            stats = streamer.run(frames, self.next_deadline_s)
+            stats = streamer.run(frames, self.next_deadline_s, self.last_send_s)
         finally:
             self.next_deadline_s = getattr(streamer, "next_deadline_s", self.next_deadline_s)
+            self.last_send_s = getattr(streamer, "last_send_s", None) or self.last_send_s
             if streamer.last_sent_ticks is not None:
                 before = streamer.previous_sent_ticks
                 self.previous_sent = before if before is not None else self.last_sent

@@ -123,8 +123,8 @@ def test_a_servo_that_never_answers_stops_before_anything_moves(tmp_path):
 
 
 @pytest.mark.parametrize("fault, words", [
-    (se.Faults(silent={3}, after_frames=FAULT_FRAME), ("servo 3", "did not return its present position")),
-    (se.Faults(late_s={3: 0.06}, after_frames=FAULT_FRAME), ("servo 3", "answered late")),
+    (se.Faults(silent={3}, after_frames=FAULT_FRAME), ("servo 3", "did not answer", "read-backs in a row")),
+    (se.Faults(late_s={3: 0.06}, after_frames=FAULT_FRAME), ("servo 3", "answers late", "ms after the request")),
     (se.Faults(corrupt_fraction=1.0, corrupt_ids={3}, after_frames=FAULT_FRAME), ("servo 3", "damaged status packet")),
 ], ids=["silent", "late", "corrupt"])
 def test_servo_fault_mid_walk_stops_within_the_bound_at_stand(tmp_path, fault, words):

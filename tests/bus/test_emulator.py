@@ -163,11 +163,18 @@ def test_silent_late_and_corrupt_faults():
     faults = se.Faults(silent={2}, late_s={3: 0.05}, corrupt_fraction=1.0, corrupt_ids={4})
     c = chain("dynamixel", 2.0, XL430, ids=(1, 2, 3, 4), faults=faults)
     c.receive(wire.build_v2(0xFE, wire.INST_SYNC_READ, bytes([132, 0, 4, 0, 1, 2, 3, 4])), 1.0)
-    assert [r[4] for r in c.due(1.04)] == [1]  # 2 silent, 3 not yet (50 ms late), 4 queued behind 3
+    # 2 silent, 3 not yet (50 ms late); 4 answers in its turn: a servo slow to answer does not hold the line
+    on_time = c.due(1.04)
+    assert [r[4] for r in on_time] == [1, 4]
+    assert not wire.parse(on_time[1], "v2", status=True).checksum_ok
     late = c.due(1.1)
-    assert [r[4] for r in late] == [3, 4]
+    assert [r[4] for r in late] == [3]
     assert wire.parse(late[0], "v2", status=True).checksum_ok
-    assert not wire.parse(late[1], "v2", status=True).checksum_ok
+    # a late servo asked again and again answers each question 50 ms after it, not 50 ms more each time
+    for k in range(5):
+        c.receive(wire.build_v2(3, wire.INST_READ, bytes([132, 0, 4, 0])), 2.0 + 0.01 * k)
+    assert c.next_due_s() == pytest.approx(2.05, abs=2e-3)
+    assert max(t for t, _ in c.outbox) == pytest.approx(2.09, abs=2e-3)
 
 
 def test_goal_log_is_a_bus_recording(tmp_path):

@@ -172,15 +172,26 @@ def test_acceleration_over_limit_found_at_its_joint_and_time(xl430):
 
 
 def test_differences_use_the_files_own_non_uniform_times(xl430):
-    # knee_pitch_left at t = 0, 0.1, 0.3, 0.4 s: 0, 1, 5, 5 deg.
-    # velocities (at the later sample): 10 @0.1, 20 @0.3, 0 @0.4 deg/s
-    # accelerations (at the middle sample): 2(20-10)/0.3 = 66.7 @0.1, 2(0-20)/0.3 = -133.3 @0.3 deg/s^2
-    t = np.array([0.0, 0.1, 0.3, 0.4])
+    # knee_pitch_left at t = 0, 0.05, 0.15, 0.2 s: 0, 1, 5, 5 deg.
+    # velocities (at the later sample): 20 @0.05, 40 @0.15, 0 @0.2 deg/s
+    # accelerations (at the middle sample): 2(40-20)/0.15 = 266.7 @0.05, 2(0-40)/0.15 = -533.3 @0.15 deg/s^2
+    t = np.array([0.0, 0.05, 0.15, 0.2])
     angles = np.zeros((4, 6))
     angles[:, 1] = [0, 1, 5, 5]
     knee = check_trajectory(xl430, t, angles).joints[1]
-    assert knee.worst_velocity_dps == pytest.approx(20.0) and knee.worst_velocity_t_s == pytest.approx(0.3)
-    assert knee.worst_acceleration_dps2 == pytest.approx(400 / 3) and knee.worst_acceleration_t_s == pytest.approx(0.3)
+    assert knee.worst_velocity_dps == pytest.approx(40.0) and knee.worst_velocity_t_s == pytest.approx(0.15)
+    assert knee.worst_acceleration_dps2 == pytest.approx(1600 / 3) and knee.worst_acceleration_t_s == pytest.approx(0.15)
+
+
+def test_a_slow_rate_cannot_hide_a_jump(xl430):
+    """Issue 13 case 4: frames 1000 s apart (rate 0.001 Hz) with a 45 deg change between them are a 45 deg jump
+    that a position servo makes at full speed: measured over 0.1 s (the slowest rate, 10 Hz), 450 deg/s."""
+    t = np.array([0.0, 1000.0, 2000.0])
+    angles = np.zeros((3, 6))
+    angles[:, 1] = [0, 45, 45]
+    report = check_trajectory(xl430, t, angles)
+    assert not report.ok
+    assert report.joints[1].worst_velocity_dps == pytest.approx(450.0)
 
 
 # --- ticks and the wrap seam ------------------------------------------------------------------------

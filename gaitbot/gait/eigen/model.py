@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from gaitbot.errors import UserError
+from gaitbot.gait.npz_file import NpzProblem, numeric, read_npz
 
 from ..geometry import LegGeometry
 from .align import align_to_reference, resample_cycle, sample_phases
@@ -40,6 +41,10 @@ from .pose import leading_count, pose_pca
 
 MODEL_KIND = "gaitbot-eigen-gait"
 MODEL_VERSION = 1
+
+
+#: The largest roughness penalty a fit takes (beyond it every motion is a straight line anyway).
+MAX_ROUGHNESS = 1e6
 
 
 class EigenModelError(UserError, ValueError):
@@ -61,8 +66,8 @@ class FitOptions:
     label_degree: int = 2
 
     def __post_init__(self) -> None:
-        if self.samples < 8:
-            raise EigenModelError(f"samples must be 8 or more, got {self.samples}")
+        if not 8 <= self.samples <= MODEL_LIMITS["samples"]:
+            raise EigenModelError(f"samples must be 8..{MODEL_LIMITS['samples']}, got {self.samples}")
         if self.basis not in ("fourier", "bspline"):
             raise EigenModelError(f"basis must be fourier or bspline, got {self.basis!r}")
         if not (1 <= self.n_basis <= self.samples):
@@ -73,14 +78,18 @@ class FitOptions:
             v = getattr(self, name)
             if not (0.0 < v <= 1.0):
                 raise EigenModelError(f"{name} must be in (0, 1], got {v}")
+        if not 0 <= self.roughness <= MAX_ROUGHNESS:
+            raise EigenModelError(f"roughness must be 0..{MAX_ROUGHNESS:g}, got {self.roughness}")
         if not self.pose_tolerance_deg >= 0:
             raise EigenModelError(f"pose_tolerance_deg must be 0 or more degrees (inf: none), got {self.pose_tolerance_deg}")
         if self.roughness < 0:
             raise EigenModelError(f"roughness must be 0 or more, got {self.roughness}")
         if self.align not in ("dtw", "none"):
             raise EigenModelError(f"align must be dtw or none, got {self.align!r}")
-        if self.label_degree < 0:
-            raise EigenModelError(f"label_degree must be 0 or more, got {self.label_degree}")
+        if not 0 <= self.label_degree <= 10:
+            raise EigenModelError(f"label_degree must be 0..10, got {self.label_degree}")
+        if self.components is not None and not 1 <= self.components <= MODEL_LIMITS["components"]:
+            raise EigenModelError(f"components must be 1..{MODEL_LIMITS['components']}, got {self.components}")
 
 
 @dataclass(frozen=True)
@@ -205,33 +214,120 @@ class EigenGaitModel:
 
     @classmethod
     def load(cls, path: str | Path) -> "EigenGaitModel":
+        """Read a model written by ``save``; every array is checked (kind, shape, finite values, sizes within
+        MODEL_LIMITS) before use, and any problem is one EigenModelError naming the file and the array."""
         path = Path(path)
-        if not path.is_file():
+        if not path.exists():
             raise EigenModelError(f"{path}: no such file")
         try:
-            with np.load(path, allow_pickle=False) as z:
-                if "kind" not in z.files or str(z["kind"]) != MODEL_KIND:
-                    raise EigenModelError(f"{path}: not an eigen-gait model (made by `gaitbot eigen fit`)")
-                d = {k: z[k] for k in z.files}
-        except EigenModelError:
-            raise
-        except Exception as exc:
-            raise EigenModelError(f"{path}: not a readable eigen-gait model ({type(exc).__name__}: {exc})") from None
-        if int(d["version"]) != MODEL_VERSION:
-            raise EigenModelError(f"{path}: model version {int(d['version'])}, this gaitbot reads {MODEL_VERSION}")
-        g = d["geometry"]
-        return cls(str(d["basis_kind"]), int(d["n_basis"]), int(d["samples"]), bool(d["periodic"]),
-                   float(d["roughness"]), d["pose_mean"], d["pose_axes"], d["pose_eigenvalues"], d["coef_mean"],
-                   d["eigen_coefs"], d["eigenvalues"], int(d["n_components"]), d["scores"], d["labels"],
-                   d["warp_coefs"], d["durations_s"], d["right_strike_phases"], int(d["label_degree"]),
-                   LegGeometry(*map(float, g)), float(d["rate_hz"]), tuple(str(s) for s in d["sources"]),
-                   int(d.get("pose_variance_dims", 0)), d.get("pose_residuals_deg"))
+            arrays = read_npz(path)
+        except OSError as exc:
+            raise EigenModelError(f"{path}: cannot read ({exc.strerror or exc})") from None
+        except NpzProblem as exc:
+            raise EigenModelError(f"{path}: not a readable eigen-gait model ({exc})") from None
+        if "kind" not in arrays or arrays["kind"].dtype.kind != "U" or str(arrays["kind"]) != MODEL_KIND:
+            raise EigenModelError(f"{path}: not an eigen-gait model (made by `gaitbot eigen fit`)")
+        try:
+            return cls._from_arrays(arrays)
+        except NpzProblem as exc:
+            raise EigenModelError(f"{path}: {exc}") from None
+
+    @classmethod
+    def _from_arrays(cls, d: dict[str, np.ndarray]) -> "EigenGaitModel":
+        def whole(key: str, low: int, high: int) -> int:
+            value = numeric(d, key, 0)
+            if value != np.floor(value) or not low <= value <= high:
+                raise NpzProblem(f"array {key!r} must be a whole number {low}..{high}, got {float(value):g}")
+            return int(value)
+
+        def text(key: str) -> str:
+            if key not in d or d[key].dtype.kind != "U" or d[key].ndim != 0:
+                raise NpzProblem(f"array {key!r} must be one piece of text")
+            return str(d[key])
+
+        def shaped(key: str, shape: tuple, finite: bool = True) -> np.ndarray:
+            value = numeric(d, key, len(shape), finite=finite)
+            if value.shape != shape:
+                raise NpzProblem(f"array {key!r} has shape {value.shape}, expected {shape}")
+            return value
+
+        version = whole("version", 0, 10**6)
+        if version != MODEL_VERSION:
+            raise NpzProblem(f"model version {version}, this gaitbot reads {MODEL_VERSION}")
+        limits = MODEL_LIMITS
+        basis_kind = text("basis_kind")
+        if basis_kind not in ("fourier", "bspline"):
+            raise NpzProblem(f"array 'basis_kind' must be fourier or bspline, got {basis_kind!r}")
+        samples = whole("samples", 8, limits["samples"])
+        n_basis = whole("n_basis", 1, min(samples, limits["n_basis"]))
+        if basis_kind == "fourier" and n_basis % 2 == 0:
+            raise NpzProblem(f"array 'n_basis': a Fourier basis needs an odd number, got {n_basis}")
+        roughness = float(numeric(d, "roughness", 0))
+        if not 0 <= roughness <= MAX_ROUGHNESS:
+            raise NpzProblem(f"array 'roughness' must be 0..{MAX_ROUGHNESS:g}, got {roughness:g}")
+        axes = numeric(d, "pose_axes", 2)
+        dims = axes.shape[1]
+        if axes.shape[0] != 6 or not 1 <= dims <= 6:
+            raise NpzProblem(f"array 'pose_axes' has shape {axes.shape}, expected (6, d) with d 1..6")
+        if not np.any(axes):
+            raise NpzProblem("array 'pose_axes' is all zeros: no pose axis to synthesise along")
+        eigen_coefs = numeric(d, "eigen_coefs", 3)
+        m = eigen_coefs.shape[0]
+        if eigen_coefs.shape[1:] != (dims, n_basis) or not 1 <= m <= limits["components"]:
+            raise NpzProblem(f"array 'eigen_coefs' has shape {eigen_coefs.shape}, expected (M, {dims}, {n_basis}) "
+                             f"with M 1..{limits['components']}")
+        scores = numeric(d, "scores", 2)
+        n = scores.shape[0]
+        if scores.shape[1] != m or not 1 <= n <= limits["examples"]:
+            raise NpzProblem(f"array 'scores' has shape {scores.shape}, expected (N, {m}) with N 1..{limits['examples']}")
+        geometry = shaped("geometry", (6,))
+        if not (np.all(geometry[:4] > 0) and np.all(geometry[4:] >= 0) and np.all(geometry <= 2.0)):
+            raise NpzProblem("array 'geometry' must hold thigh, shank, foot, hip width (positive), ankle height and "
+                             "heel back (0 or more), each at most 2 m")
+        rate_hz = float(numeric(d, "rate_hz", 0))
+        if not 1.0 <= rate_hz <= 1000.0:
+            raise NpzProblem(f"array 'rate_hz' must be a frame rate of 1..1000 Hz, got {rate_hz:g}")
+        if "sources" not in d:
+            raise NpzProblem("missing array 'sources'")
+        sources = d["sources"]
+        if sources.dtype.kind not in "U" or sources.ndim != 1:
+            raise NpzProblem("array 'sources' must be a list of file names (text)")
+        residuals = d.get("pose_residuals_deg")
+        if residuals is not None:
+            residuals = numeric(d, "pose_residuals_deg", 1, finite=False)
+            if residuals.shape not in ((0,), (6,)):
+                raise NpzProblem(f"array 'pose_residuals_deg' has shape {residuals.shape}, expected (6,)")
+        variance_dims = whole("pose_variance_dims", 0, 6) if "pose_variance_dims" in d else 0
+        durations = shaped("durations_s", (n,))
+        if not np.all((durations >= 0.2) & (durations <= 10.0)):
+            raise NpzProblem("array 'durations_s' must hold cycle durations of 0.2..10 s")
+        labels = shaped("labels", (n,))
+        if not np.all((labels >= 0) & (labels <= 2.0)):
+            raise NpzProblem("array 'labels' must hold step lengths of 0..2 m")
+        phases = shaped("right_strike_phases", (n,))
+        if not np.all((phases > 0) & (phases < 1)):
+            raise NpzProblem("array 'right_strike_phases' must hold phases between 0 and 1")
+        return cls(basis_kind, n_basis, samples, bool(numeric(d, "periodic", 0)), roughness,
+                   shaped("pose_mean", (6,)), axes, shaped("pose_eigenvalues", (6,)),
+                   shaped("coef_mean", (dims, n_basis)), eigen_coefs, shaped("eigenvalues", (m,)),
+                   whole("n_components", 1, m), scores, labels, shaped("warp_coefs", (n, n_basis)),
+                   durations, phases, whole("label_degree", 0, 10),
+                   LegGeometry(*map(float, geometry)), rate_hz, tuple(str(x) for x in sources),
+                   variance_dims, residuals)
+
+
+#: Sizes a model file may claim (a fitted model is far inside them): samples per cycle, basis functions,
+#: eigen-motions and example cycles. Beyond them synthesis would allocate what the file asks, not what a walk needs.
+MODEL_LIMITS = {"samples": 2000, "n_basis": 401, "components": 1000, "examples": 10_000}
 
 
 def is_model_file(path: str | Path) -> bool:
     """True for an ``.npz`` written by ``EigenGaitModel.save`` (plot dispatches on this)."""
+    path = Path(path)
+    if not path.is_file():
+        return False
     try:
-        with np.load(Path(path), allow_pickle=False) as z:
+        with np.load(path, allow_pickle=False) as z:
             return "kind" in z.files and str(z["kind"]) == MODEL_KIND
     except Exception:
         return False

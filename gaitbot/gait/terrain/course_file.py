@@ -59,8 +59,27 @@ class Course:
     weights: tuple[float, float, float] | None = None
 
 
+#: Bounds of every size a course can ask for (both ends included): a course is walked, planned and searched
+#: over its whole length, so its length bounds the work (docs/file-formats.md).
+POSITION_RANGE_M = (-100.0, 100.0, "m")
+MAX_COURSE_M = 20.0
+MARGIN_RANGE_M = (0.0, 0.1, "m")
+OPTIONAL_RANGES_M = {"clearance_m": (0.0, 0.5, "m"), "max_step_m": (0.005, 2.0, "m"), "max_rise_m": (0.001, 1.0, "m")}
+TREAD_LENGTH_RANGE_M = (0.005, 20.0, "m")
+HEIGHT_RANGE_M = (-1.0, 1.0, "m")
+MAX_TREADS = 100
+
 _COURSE_KEYS = ("start_m", "end_m", "margin_m", "clearance_m", "max_step_m", "max_rise_m")
 _TREAD_KEYS = ("start_m", "length_m", "height_m")
+
+
+def _tread(fields: Fields, t: dict, i: int) -> Tread:
+    try:
+        return Tread(fields.number(t, "start_m", f"tread[{i}]", within=POSITION_RANGE_M),
+                     fields.number(t, "length_m", f"tread[{i}]", positive=True, within=TREAD_LENGTH_RANGE_M),
+                     fields.number(t, "height_m", f"tread[{i}]", within=HEIGHT_RANGE_M))
+    except TerrainFileError as exc:
+        raise TerrainFileError(exc.path, exc.field, f"{exc.reason} (tread {i})") from None
 
 
 def load_course(path) -> Course:
@@ -70,13 +89,16 @@ def load_course(path) -> Course:
     fields = Fields(path, TerrainFileError)
     fields.no_unknown_keys(data, "", ("course", "search", "tread"))
     course = fields.table(data, "course", "course", _COURSE_KEYS)
-    start = fields.number(course, "start_m", "course")
-    end = fields.number(course, "end_m", "course")
+    start = fields.number(course, "start_m", "course", within=POSITION_RANGE_M)
+    end = fields.number(course, "end_m", "course", within=POSITION_RANGE_M)
     if end <= start:
         raise fields.fail("course.end_m", f"{end:g} must lie beyond start_m {start:g}")
-    margin = fields.number(course, "margin_m", "course", non_negative=True, default=0.01)
+    if end - start > MAX_COURSE_M:
+        raise fields.fail("course.end_m", f"{end:g} is {end - start:g} m beyond start_m {start:g}; a course may be at "
+                                          f"most {MAX_COURSE_M:g} m long")
+    margin = fields.number(course, "margin_m", "course", non_negative=True, default=0.01, within=MARGIN_RANGE_M)
     optional = {key: fields.number(course, key, "course", positive=key != "clearance_m",
-                                   non_negative=key == "clearance_m")
+                                   non_negative=key == "clearance_m", within=OPTIONAL_RANGES_M[key])
                 for key in ("clearance_m", "max_step_m", "max_rise_m") if key in course}
     search = fields.optional_table(data, "search", "search", ("weights",))
     weights = None
@@ -84,14 +106,14 @@ def load_course(path) -> Course:
         raw = search["weights"]
         if not isinstance(raw, list) or len(raw) != 3:
             raise fields.fail("search.weights", f"must be a list of 3 numbers (hip, knee, ankle), got {raw!r}")
-        weights = tuple(fields.check_number(w, f"search.weights[{i}]", non_negative=True)
+        weights = tuple(fields.check_number(w, f"search.weights[{i}]", non_negative=True, within=(0.0, 1e6, ""))
                         for i, w in enumerate(raw, start=1))
         if sum(weights) <= 0:
             raise fields.fail("search.weights", "at least one weight must be positive")
-    treads = tuple(Tread(fields.number(t, "start_m", f"tread[{i}]"),
-                         fields.number(t, "length_m", f"tread[{i}]", positive=True),
-                         fields.number(t, "height_m", f"tread[{i}]"))
-                   for i, t in enumerate(fields.tables(data, "tread", _TREAD_KEYS), start=1))
+    tables = fields.tables(data, "tread", _TREAD_KEYS)
+    if len(tables) > MAX_TREADS:
+        raise fields.fail("tread", f"{len(tables)} treads, more than the {MAX_TREADS} a course may have")
+    treads = tuple(_tread(fields, t, i) for i, t in enumerate(tables, start=1))
     try:
         terrain = Terrain(treads)
     except TerrainError as exc:

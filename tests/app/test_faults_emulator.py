@@ -1,0 +1,101 @@
+"""Every fault scenario of issue 13 on the servo emulator, in real time, through the command line:
+``gaitbot walk --record`` against a faulty chain, then ``gaitbot check --allow-partial`` on the
+recording. The promises: exit 1, the faulty servo named (and no other), no goal frame after the fault
+waits on a read (no gap over two periods, none under half a period), the stop ramp within every
+joint limit on the frame grid, the recording readable, and a servo faulty from the start stops the
+walk before any goal reaches the chain.
+
+Real time on a shared machine: limits are judged on the frame grid (the session's own clock), as the
+pacing rule allows the send times a host's jitter; ``gaitbot check`` must read the recording and find
+no position or tick-range error.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gaitbot.bus import emulator as se
+from gaitbot.bus.log import decode_goal_frames
+from gaitbot.check.trajectory import check_trajectory
+from gaitbot.robot.calibration import ticks_to_angles
+from gaitbot.robot.config import load_robot_config
+from helpers import CONFIG_DIR, emulator_for, gaitbot
+
+FAULT_FRAME = 120
+#: the servo each scenario hurts: ankle_pitch_left (id 3) on xl430 and sts3215, knee_pitch_left (13) on ax12a
+VICTIM = {"xl430-biped": 3, "sts3215-biped": 3, "ax12a-biped": 13}
+
+pytestmark = pytest.mark.xdist_group("emulator")
+
+
+def scenario(robot: str, kind: str, mid_walk: bool = True):
+    v = VICTIM[robot]
+    after = FAULT_FRAME if mid_walk else 0
+    faults = {"late": se.Faults(late_s={v: 0.1}, after_frames=after),
+              "silent": se.Faults(silent={v}, after_frames=after),
+              "overload": se.Faults(errors={v: {"overload"}}, after_frames=after),
+              "corrupt": se.Faults(corrupt_fraction=1.0, corrupt_ids={v}, after_frames=after)}[kind]
+    return pytest.param(robot, kind, faults, mid_walk, id=f"{robot}-{kind}-{'mid-walk' if mid_walk else 'at-start'}")
+
+
+SCENARIOS = [scenario("xl430-biped", kind) for kind in ("late", "silent", "overload", "corrupt")] + [
+    scenario("xl430-biped", "late", mid_walk=False), scenario("ax12a-biped", "late"),
+    scenario("ax12a-biped", "late", mid_walk=False), scenario("sts3215-biped", "silent"),
+    scenario("sts3215-biped", "overload")]
+
+
+def grid_limit_errors(config, ticks: np.ndarray, from_frame: int) -> list[str]:
+    """Joint limits of the goal frames from ``from_frame - 2`` on, one period apart (the session's grid)."""
+    start = max(0, from_frame - 2)
+    angles = np.degrees(ticks_to_angles(config, ticks[start:]))
+    t = np.arange(len(angles)) / config.gait.rate_hz
+    report = check_trajectory(config, t, angles)
+    # one tick of rounding in each frame is what no integer goal can avoid
+    slack = {"velocity": config.gait.rate_hz, "acceleration": 2 * config.gait.rate_hz ** 2}
+    errors = []
+    for v in report.errors:
+        joint = next(j for j in config.joints if j.name == v.joint)
+        tick_deg = 360.0 / (2 * np.pi * joint.model.ticks_per_rad)
+        if v.kind in slack and abs(v.value) <= v.limit + slack[v.kind] * tick_deg + 1e-9:
+            continue
+        errors.append(v.describe())
+    return errors
+
+
+@pytest.mark.parametrize("robot, kind, faults, mid_walk", SCENARIOS)
+def test_a_fault_stops_the_walk_safely_and_the_recording_checks(tmp_path, robot, kind, faults, mid_walk):
+    config_path = CONFIG_DIR / f"{robot}.toml"
+    config = load_robot_config(config_path)
+    victim = VICTIM[robot]
+    record, emu_log = tmp_path / "walk.jsonl", tmp_path / "emulator.jsonl"
+    with emulator_for(config_path, emu_log, faults) as emulator:
+        proc = gaitbot("walk", "--robot", str(config_path), "--port", emulator.path, "--distance", "0.3",
+                       "--record", str(record))
+    out = proc.stdout + proc.stderr
+    assert proc.returncode == 1, out
+    assert "Traceback" not in out
+    named = {int(x) for x in re.findall(r"servos? (\d+)", out)}
+    assert named == {victim}, out
+    if kind == "overload":
+        assert "overload" in out
+    _, _, received = decode_goal_frames(emu_log)
+    if not mid_walk:
+        assert len(received) == 0, "goals reached a chain whose servo was faulty from the start"
+        return
+    assert "ramped to the stand pose" in out, out
+    _, t_s, ticks = decode_goal_frames(record, allow_partial_last_line=True)
+    gaps = np.diff(t_s[FAULT_FRAME - 1:]) * config.gait.rate_hz
+    assert gaps.max() < 2.0, f"a goal frame after the fault came {gaps.max():.2f} periods after the one before"
+    assert gaps.min() > 0.1, f"a goal frame after the fault came {gaps.min():.2f} periods after the one before"
+    assert t_s[-1] - t_s[FAULT_FRAME - 1] < 2.0  # fault to the last goal: detection plus the stop ramp
+    assert grid_limit_errors(config, ticks, FAULT_FRAME) == []
+    check = gaitbot("check", "--allow-partial", "--json", str(record))
+    assert check.returncode in (0, 1), check.stderr
+    report = json.loads(check.stdout)
+    violations = report["joint_check"]["violations"]
+    assert not {v["kind"] for v in violations} & {"position", "tick_range", "wrap_seam"}, violations[:3]
