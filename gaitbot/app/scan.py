@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from gaitbot.app.hardware import serial_port
+from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port
 from gaitbot.app.options import load_robot
 from gaitbot.bus.factory import make_robot_bus
 
 
 def run(args) -> int:
+    refuse_port_in_dry_run(args)
     config = load_robot(args.robot)
     port = serial_port(config, args.port, args.dry_run)
     ids = range(0, 253) if args.all else config.ids

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import sys
 
-from gaitbot.app.hardware import serial_port, warn_about_latency
+from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
+from gaitbot.app.progress import progress
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, load_robot
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
@@ -23,25 +24,23 @@ from gaitbot.stream.clock import MonotonicClock, VirtualClock
 from gaitbot.stream.session import walk_session
 
 
-def _status_line(total: int, strikes, rate_hz: float):
-    """A cheap live status line: frame, step and late frames, rewritten in place on a terminal."""
-    out = sys.stderr
-    if not out.isatty():
-        return None
+def _status(bar, strikes, rate_hz: float):
+    """The walk's live status on the bar: step and late frames (the bar itself counts frames)."""
     times = [h.t_s for h in strikes]
 
     def on_frame(k: int, stats) -> None:
         if k % 6:
             return
         step = sum(1 for t in times if t <= k / rate_hz)
-        out.write(f"\rframe {k + 1}/{total}  step {step}/{len(times)}  late {stats.late_frames}   ")
-        out.flush()
+        bar.update(k + 1 - bar.n)
+        bar.set_postfix_str(f"step {step}/{len(times)}, {stats.late_frames} late; Ctrl-C stops safely", refresh=False)
 
     return on_frame
 
 
 def run(args) -> int:
     check_sim_arguments(args)
+    refuse_port_in_dry_run(args)
     check_reply_timeout(args.reply_timeout_ms)
     config = load_robot(args.robot)
     check_rate_option(config, args.rate)
@@ -74,19 +73,19 @@ def run(args) -> int:
     velocity, acceleration = joint_limits_ticks(config)
     for note in gain_notes(config):
         print(f"note: {note}", file=sys.stderr)
+    what = "simulating" if sim is not None else "walking"
     try:
-        result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
-                              max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
-                              torque_off_on_exit=config.bus.torque_off_on_exit,
-                              on_frame=_status_line(len(frames), walker.heel_strikes, source.settings.rate_hz),
-                              setup_writes=gain_writes(config))
+        with progress(what, total=len(frames), unit="frame") as bar:
+            result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
+                                  max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
+                                  torque_off_on_exit=config.bus.torque_off_on_exit,
+                                  on_frame=_status(bar, walker.heel_strikes, source.settings.rate_hz),
+                                  setup_writes=gain_writes(config))
     finally:
         if recorder is not None:
             recorder.close()
     for note in getattr(bus, "open_notes", []):
         print(f"note: {note}", file=sys.stderr)
-    if sys.stderr.isatty():
-        sys.stderr.write("\n")
     if sim is not None and args.json:
         sim.print_report(True, result.outcome)
         return result.exit_code
@@ -98,11 +97,11 @@ def run(args) -> int:
     elif args.realtime:
         mode = "dry run (mock bus, paced in real time)"
     else:
-        mode = "dry run (mock bus, simulated clock: timing figures are exact by construction; --realtime paces it)"
+        mode = "dry run (mock bus, simulated clock; --realtime paces it)"
     print(f"{config.name}: {mode}: {len(walker.planned_steps)} heel strikes, "
           f"{trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.3f} m planned. {result.message()}")
     if result.walk_stats is not None:
-        print(result.walk_stats.summary())
+        print(result.walk_stats.summary(simulated_clock=isinstance(clock, VirtualClock)))
     if args.record:
         print(f"recording: {args.record}")
     if sim is not None:

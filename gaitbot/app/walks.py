@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gaitbot.app.options import UsageError, check_rate_option, gait_source, step_lengths
+from gaitbot.gait.footfall import detect_heel_strikes
 from gaitbot.gait.segments import GaitGenerationError
 from gaitbot.gait.step_length import StepLengthError
 from gaitbot.gait.terrain.course_file import load_course
@@ -30,7 +31,8 @@ def build_walk(args) -> tuple[GaitSource, OnlineWalker]:
 
 @dataclass(frozen=True)
 class FileWalk:
-    """A trajectory file walked as it is (``walk --trajectory``): its heel strikes stand for the plan."""
+    """A trajectory file walked as it is (``walk --trajectory``): its heel strikes (the file's, or found from
+    the feet) stand for the plan."""
 
     heel_strikes: tuple
 
@@ -61,8 +63,9 @@ def trajectory_file_walk(args) -> tuple[GaitSource, FileWalk, Trajectory]:
     if source.robot is not None:
         check_rate_option(source.robot, rate, f"--trajectory {args.trajectory}: its {rate:.4g} Hz")
     settings = WalkSettings(source.settings.cycle_s, rate, source.settings.clearance)
-    return GaitSource(source.geometry, settings, source.max_step_m, source.robot), \
-        FileWalk(tuple(trajectory.heel_strikes)), trajectory
+    # a CSV carries no heel strikes: find them from the feet, as plot and eigen fit do (footfall.py)
+    strikes = tuple(trajectory.heel_strikes) or tuple(detect_heel_strikes(trajectory, source.geometry))
+    return GaitSource(source.geometry, settings, source.max_step_m, source.robot), FileWalk(strikes), trajectory
 
 
 def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:

@@ -110,6 +110,7 @@ class EigenGaitModel:
     sources: tuple = field(default_factory=tuple)
     pose_variance_dims: int = 0  # pose axes the variance rule alone would keep (0: not recorded)
     pose_residuals_deg: np.ndarray | None = None  # (6,) largest joint error of the examples with 1..6 pose axes
+    robot: str = ""  # the robot the examples were walked for (its config's name); "" in files that predate it
 
     # -- basic evaluation -------------------------------------------------------------------
     @property
@@ -200,7 +201,7 @@ class EigenGaitModel:
                  right_strike_phases=self.right_strike_phases, label_degree=self.label_degree,
                  geometry=np.array([g.thigh, g.shank, g.foot, g.hip_width, g.ankle_height, g.heel_back]),
                  rate_hz=self.rate_hz, sources=np.array([str(s) for s in self.sources], dtype=str),
-                 pose_variance_dims=self.pose_variance_dims,
+                 pose_variance_dims=self.pose_variance_dims, robot=np.array(self.robot),
                  pose_residuals_deg=np.full(0, np.nan) if self.pose_residuals_deg is None else self.pose_residuals_deg)
 
     @classmethod
@@ -225,7 +226,7 @@ class EigenGaitModel:
                    d["eigen_coefs"], d["eigenvalues"], int(d["n_components"]), d["scores"], d["labels"],
                    d["warp_coefs"], d["durations_s"], d["right_strike_phases"], int(d["label_degree"]),
                    LegGeometry(*map(float, g)), float(d["rate_hz"]), tuple(str(s) for s in d["sources"]),
-                   int(d.get("pose_variance_dims", 0)), d.get("pose_residuals_deg"))
+                   int(d.get("pose_variance_dims", 0)), d.get("pose_residuals_deg"), str(d.get("robot", "")))
 
 
 def is_model_file(path: str | Path) -> bool:
@@ -238,8 +239,10 @@ def is_model_file(path: str | Path) -> bool:
 
 
 def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: float,
-              options: FitOptions = FitOptions(), periodic: bool = True) -> EigenGaitModel:
-    """Seed 004 sections 3 and 4 on example cycles (see the module docstring)."""
+              options: FitOptions = FitOptions(), periodic: bool = True, robot: str = "") -> EigenGaitModel:
+    """Seed 004 sections 3 and 4 on example cycles (see the module docstring). ``geometry`` is the leg that
+    walked the examples and ``robot`` the robot they are for: the model keeps both, and synthesis for
+    another leg or robot is refused (app/eigen.py)."""
     n = len(examples)
     if n < 2:
         raise EigenModelError(f"functional PCA needs at least 2 example cycles, got {n}")
@@ -301,4 +304,4 @@ def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: floa
                           np.array([e.duration_s for e in examples]),
                           np.array([e.right_strike_phase for e in examples]), options.label_degree, geometry,
                           float(rate_hz), tuple(sorted({e.source for e in examples})), pose.variance_dims,
-                          pose.residuals_deg)
+                          pose.residuals_deg, robot)
