@@ -27,7 +27,7 @@ from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, cyc
                                 synthesize_walk, walk_label)
 from gaitbot.gait.trajectory import WALKING_JOINTS, Trajectory
 from gaitbot.app.options import UsageError, gait_source, load_robot
-from gaitbot.app.progress import progress
+from gaitbot.app.progress import callback, progress
 from gaitbot.errors import UserError
 from gaitbot.check.preflight import preflight
 from gaitbot.robot.walk_settings import walk_settings
@@ -51,7 +51,6 @@ def load_examples(paths, geometry, robot_rate_hz: float | None = None, config=No
     ``done(1)`` is called after each file (a progress bar)."""
     examples, rates = [], []
     for path in paths:
-        done(0)
         trajectory = Trajectory.load(path)
         if config is not None:
             report = preflight(config, trajectory)
@@ -82,8 +81,9 @@ def run_fit(args) -> int:
                          label_degree=args.label_degree)
     with progress("eigen fit: reading examples", total=len(args.examples), unit="file") as bar:
         examples, rate = load_examples(args.examples, source.geometry, config.gait.rate_hz, source.robot, bar.update)
-    with progress("eigen fit: fitting (DTW, pose PCA, functional PCA)"):
-        model = fit_model(examples, source.geometry, rate, options, periodic=args.basis == "fourier", robot=config.name)
+    with progress("eigen fit: aligning cycles (DTW)", total=len(examples), unit="cycle") as bar:
+        model = fit_model(examples, source.geometry, rate, options, periodic=args.basis == "fourier", robot=config.name,
+                          on_progress=callback(bar))
     model.save(out)
     labels = sorted(set(np.round(model.labels, 6)))
     print(f"wrote {out}: {len(examples)} example cycles from {len(args.examples)} files, step lengths "

@@ -8,6 +8,7 @@ nothing is printed: output meant for people must not end up in logs.
 
 from __future__ import annotations
 
+import os
 import sys
 from contextlib import contextmanager
 
@@ -24,8 +25,12 @@ class _Silent:
     """What a bar is when nobody is watching."""
 
     n = 0
+    total = None
 
     def update(self, n: int = 1) -> None:
+        pass
+
+    def reset(self, total: int | None = None) -> None:
         pass
 
     def set_postfix_str(self, text: str, refresh: bool = True) -> None:
@@ -38,6 +43,16 @@ class _Silent:
         pass
 
 
+def _size() -> tuple[int, int]:
+    """The terminal's columns and lines; one that reports no size (a fresh pseudo-terminal, some serial consoles)
+    gets 100 x 24, since tqdm would otherwise draw nothing at all (a bar 0 wide, on row -1)."""
+    try:
+        size = os.get_terminal_size(sys.stderr.fileno())
+        return size.columns or 100, size.lines or 24
+    except (OSError, ValueError):
+        return 100, 24
+
+
 @contextmanager
 def progress(what: str, total: int | None = None, unit: str = "it", leave: bool = False):
     """A bar for ``total`` pieces of work (or a counter if None); ``update(n)`` as pieces are done.
@@ -46,8 +61,9 @@ def progress(what: str, total: int | None = None, unit: str = "it", leave: bool 
     if not on_terminal():
         yield _Silent()
         return
-    bar = tqdm(total=total, desc=what, unit=unit, leave=leave, file=sys.stderr, dynamic_ncols=True,
-               mininterval=0.1, bar_format=None if total else "{desc}: {elapsed}{postfix}")
+    columns, lines = _size()
+    bar = tqdm(total=total, desc=what, unit=unit, leave=leave, file=sys.stderr, ncols=columns, nrows=lines,
+               mininterval=0.1)
     try:
         yield bar
     finally:
@@ -58,7 +74,7 @@ def callback(bar):
     """``done(k, n)`` for rooms that report progress as "k of n done" (they import nothing of the app)."""
 
     def done(k: int, n: int) -> None:
-        if bar.total != n and hasattr(bar, "reset"):
+        if bar.total != n:
             bar.reset(total=n)
         bar.update(k - bar.n)
 

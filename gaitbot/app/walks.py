@@ -4,10 +4,12 @@ plan and a trajectory, for ``plan``, ``generate`` and ``walk``."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from gaitbot.app.options import UsageError, check_rate_option, gait_source, step_lengths
+from gaitbot.app.progress import callback, progress
 from gaitbot.gait.footfall import detect_heel_strikes
 from gaitbot.gait.segments import GaitGenerationError
 from gaitbot.gait.step_length import StepLengthError
@@ -84,8 +86,9 @@ def build_terrain_walk(args):
     course = load_course(args.terrain)
     settings = terrain_settings(source, course, getattr(args, "clearance", None))
     try:
-        walk = plan_terrain_walk(make_context(source.geometry, source.settings), course.terrain, course.start_m,
-                                 course.end_m, settings, source.max_step_m)
+        with progress(f"planning {Path(course.path).name}", unit="step") as bar:
+            walk = plan_terrain_walk(make_context(source.geometry, source.settings), course.terrain, course.start_m,
+                                     course.end_m, settings, source.max_step_m, on_progress=callback(bar))
     except CourseError as exc:
         raise UsageError(f"{course.path}: {exc}") from None
     except GaitGenerationError as exc:

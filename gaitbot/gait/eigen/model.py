@@ -239,10 +239,12 @@ def is_model_file(path: str | Path) -> bool:
 
 
 def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: float,
-              options: FitOptions = FitOptions(), periodic: bool = True, robot: str = "") -> EigenGaitModel:
+              options: FitOptions = FitOptions(), periodic: bool = True, robot: str = "",
+              on_progress=None) -> EigenGaitModel:
     """Seed 004 sections 3 and 4 on example cycles (see the module docstring). ``geometry`` is the leg that
     walked the examples and ``robot`` the robot they are for: the model keeps both, and synthesis for
-    another leg or robot is refused (app/eigen.py)."""
+    another leg or robot is refused (app/eigen.py). ``on_progress(k, n)``, if given, is told as each of the n
+    example cycles is aligned (the time-consuming part: dynamic time warping)."""
     n = len(examples)
     if n < 2:
         raise EigenModelError(f"functional PCA needs at least 2 example cycles, got {n}")
@@ -258,13 +260,15 @@ def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: floa
     cycles = [resample_cycle(e.angles_rad, options.samples, periodic) for e in examples]
     reference = cycles[int(np.argsort(labels)[n // 2])]
     aligned, warps = [], []
-    for c in cycles:
+    for k, c in enumerate(cycles, start=1):
         if options.align == "dtw":
             a, h = align_to_reference(reference, c, options.dtw_band, periodic)
         else:
             a, h = c, phases.copy()
         aligned.append(a)
         warps.append(h)
+        if on_progress is not None:
+            on_progress(k, n)
     aligned = np.array(aligned)  # (N, S, 6)
 
     # pose PCA (eq. 1; pose.py)
