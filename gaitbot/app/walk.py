@@ -9,12 +9,13 @@ from __future__ import annotations
 import sys
 
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
-from gaitbot.app.progress import progress
+from gaitbot.app.progress import callback, progress
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, load_robot
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.log import BusRecorder
 from gaitbot.check.preflight import preflight
+from gaitbot.errors import UserError
 from gaitbot.robot.calibration import angles_to_ticks, standing_ticks
 from gaitbot.robot.gains import gain_notes, gain_writes
 from gaitbot.robot.walk_settings import joint_limits_ticks
@@ -22,6 +23,13 @@ from gaitbot.sim import import_mujoco
 from gaitbot.sim.video import check_video_path
 from gaitbot.stream.clock import MonotonicClock, VirtualClock
 from gaitbot.stream.session import walk_session
+
+
+class LimitBroken(UserError):
+    """The walk breaks a limit of the robot: refused before anything moves, in one line. The check failed, as
+    ``gaitbot check`` fails on the same file: exit 1 (docs/command-line.md), not 2 (the input is readable)."""
+
+    exit_status = 1
 
 
 def _status(bar, strikes, rate_hz: float):
@@ -48,7 +56,7 @@ def run(args) -> int:
     source, walker, trajectory = trajectory_for_robot(args)
     report = preflight(config, trajectory)
     if not report.ok:
-        raise UsageError(f"walk refused before anything moved: {report.first_error}")
+        raise LimitBroken(f"walk refused before anything moved: {report.first_error}")
     frames = angles_to_ticks(config, trajectory.angles_rad)
     period = 1.0 / source.settings.rate_hz
     sim = None
@@ -87,8 +95,7 @@ def run(args) -> int:
     for note in getattr(bus, "open_notes", []):
         print(f"note: {note}", file=sys.stderr)
     if sim is not None and args.json:
-        sim.print_report(True, result.outcome)
-        return result.exit_code
+        return _sim_exit(_sim_report(sim, True, result.outcome, args.video), result.exit_code)
     if sim is not None:
         mode = (f"simulated robot (MuJoCo; {config.bus.backend} packets on a simulated bus, simulated clock; "
                 f"torso {'free to pitch' if args.free_pitch else 'on a boom, pitch held'})")
@@ -105,8 +112,18 @@ def run(args) -> int:
     if args.record:
         print(f"recording: {args.record}")
     if sim is not None:
-        sim.print_report(False, result.outcome)
+        return _sim_exit(_sim_report(sim, False, result.outcome, args.video), result.exit_code)
     return result.exit_code
+
+
+def _sim_report(sim, as_json: bool, outcome: str, video: str | None):
+    with progress(f"writing {video}" if video else "measuring", unit="frame") as bar:
+        return sim.print_report(as_json, outcome, callback(bar))
+
+
+def _sim_exit(report, session_exit: int) -> int:
+    """A simulated robot that fell failed its walk: exit 1 (docs/command-line.md), whatever the session says."""
+    return 1 if report.fell and session_exit == 0 else session_exit
 
 
 def check_sim_arguments(args) -> None:
