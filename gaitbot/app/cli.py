@@ -15,7 +15,7 @@ import os
 import sys
 
 from gaitbot import __version__
-from gaitbot.app.help import COMMAND_HELP, EPILOG, HelpFormatter
+from gaitbot.app.help import COMMAND_HELP, DESCRIPTION, EPILOG, HelpFormatter
 from gaitbot.bus.base import BusError
 from gaitbot.errors import UserError
 
@@ -74,7 +74,7 @@ def _command(sub, name: str, **kwargs) -> argparse.ArgumentParser:
 
 def build_parser() -> argparse.ArgumentParser:
     """The parser; ``parser.commands`` maps each subcommand to its own parser (its errors print its usage)."""
-    parser = argparse.ArgumentParser(prog="gaitbot", description="Walking gaits for small servo bipeds.",
+    parser = argparse.ArgumentParser(prog="gaitbot", description=DESCRIPTION,
                                      epilog=EPILOG, formatter_class=HelpFormatter)
     parser.add_argument("--version", action="version", version=f"gaitbot {__version__}")
     parser.add_argument("--debug", action="store_true", help="show the traceback of an error")

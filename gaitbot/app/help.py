@@ -34,6 +34,10 @@ EXIT_STATUSES = """exit status:
   141  the output was closed early (e.g. piped into head)
   143  stopped by SIGTERM (as Ctrl-C)"""
 
+DESCRIPTION = """Walking gaits for small servo bipeds: plan and generate walks (Boulic's model with exact step
+lengths, terrain, eigen-gaits), check them against the robot's limits, and stream them at the robot's
+frame rate to Dynamixel or Feetech servos, a mock bus or a simulated robot."""
+
 EPILOG = f"""{EXIT_STATUSES}
 
 examples:
