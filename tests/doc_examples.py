@@ -10,7 +10,10 @@ Rules (also in docs/command-line.md, for whoever writes a page):
   runs until interrupted: it gets SIGINT after INTERRUPT_AFTER_S. Nothing it prints may be a traceback.
 - A command that needs hardware (``gaitbot walk``, ``record`` or ``scan`` without ``--dry-run`` or ``--sim``)
   runs against the servo emulator (gaitbot.bus.emulator) of its robot on a pty, given as ``--port``: the
-  emulator answers as the servos do, through the same vendor SDKs. Questions are answered ``y``.
+  emulator answers as the servos do, through the same vendor SDKs. Such a command also gets
+  ``--reply-timeout-ms 250`` unless it names one: the emulator shares a busy CI host with the suite, and a
+  reply held up by the host is not what the text is about (faults are tests/app/test_emulator_e2e.py's).
+  Questions are answered ``y``.
 - ``<!-- setup: COMMAND -->`` before a block runs COMMAND first, unseen: files the text assumes exist.
 - Installing (``python3 -m venv``, ``. .venv/bin/activate``, ``pip install``) is what the test environment
   already is (.ci/run makes it exactly so), and ``pytest`` is this suite: those parts of a line are not run
@@ -140,8 +143,12 @@ def hardware_robot(command: str) -> str | None:
 
 def with_port(command: str, port: str) -> str:
     if re.search(r"--port[= ]\S+", command):
-        return re.sub(r"--port[= ]\S+", f"--port {port}", command)
-    return f"{command} --port {port}"
+        command = re.sub(r"--port[= ]\S+", f"--port {port}", command)
+    else:
+        command = f"{command} --port {port}"
+    if "--reply-timeout-ms" not in command:
+        command += " --reply-timeout-ms 250"
+    return command
 
 
 @dataclass(frozen=True)

@@ -192,8 +192,7 @@ def check_sources(parser: argparse.ArgumentParser, args) -> None:
         return
     if args.command == "walk" and (args.dry_run or args.sim):
         args.distance = DEMO_DISTANCE_M
-        print(f"note: no --steps, --distance, --terrain or --trajectory: walking the demo, --distance "
-              f"{DEMO_DISTANCE_M:g}", file=sys.stderr)
+        args.demo = True  # said by the walk once its other options are found good (app/walk.py)
         return
     extra = " or --trajectory" if args.command == "walk" else ""
     own.error(f"give --steps, --distance or --terrain{extra} (e.g. --distance 1.0)")

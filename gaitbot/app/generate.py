@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gaitbot.app.options import UsageError
+from gaitbot.app.options import UsageError, walked_by
 from gaitbot.app.walks import trajectory_for_robot
 
 
@@ -12,8 +12,8 @@ def run(args) -> int:
     out = Path(args.output)
     if out.suffix not in (".csv", ".npz"):
         raise UsageError(f"-o {out}: the output must end in .csv or .npz")
-    _, walker, trajectory = trajectory_for_robot(args)
+    source, walker, trajectory = trajectory_for_robot(args)
     trajectory.save(out)
-    print(f"wrote {out}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
+    print(f"wrote {out} for {walked_by(source)}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
           f"{len(walker.heel_strikes)} heel strikes, {trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.4f} m")
     return 0

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gaitbot.app.options import UsageError, gait_source
+from gaitbot.app.options import UsageError, gait_source, walked_by
 from gaitbot.gait.eigen import is_model_file
 from gaitbot.gait.terrain.course_file import load_course
 from gaitbot.gait.trajectory import Trajectory
@@ -29,5 +29,5 @@ def run(args) -> int:
         terrain = load_course(args.terrain).terrain
     plot_trajectory(trajectory, source.geometry, out, clearance=source.settings.clearance, title=Path(args.file).name,
                     terrain=terrain)
-    print(f"wrote {out}")
+    print(f"wrote {out} (the feet drawn for {walked_by(source)})")
     return 0

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port
-from gaitbot.app.options import load_robot
+from gaitbot.app.options import check_reply_timeout, load_robot
 from gaitbot.bus.factory import make_robot_bus
 
 
@@ -13,7 +13,8 @@ def run(args) -> int:
     port = serial_port(config, args.port, args.dry_run)
     ids = range(0, 253) if args.all else config.ids
     names = {j.id: j.name for j in config.joints}
-    bus = make_robot_bus(config, port, dry_run=args.dry_run)
+    check_reply_timeout(args.reply_timeout_ms)
+    bus = make_robot_bus(config, port, dry_run=args.dry_run, reply_timeout_ms=args.reply_timeout_ms)
     with bus:
         found = bus.scan(ids)
     for servo_id in ids if not args.all else found:

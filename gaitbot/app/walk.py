@@ -49,6 +49,9 @@ def _status(bar, strikes, rate_hz: float):
 def run(args) -> int:
     check_sim_arguments(args)
     refuse_port_in_dry_run(args)
+    if getattr(args, "demo", False):
+        print(f"note: no --steps, --distance, --terrain or --trajectory: walking the demo, --distance "
+              f"{args.distance:g}", file=sys.stderr)
     check_reply_timeout(args.reply_timeout_ms)
     config = load_robot(args.robot)
     check_rate_option(config, args.rate)

@@ -78,3 +78,13 @@ def test_walking_a_csv_counts_its_heel_strikes(capsys, walk_csv):
     code, out, _ = run_cli(capsys, "walk", "--trajectory", walk_csv, "--dry-run")
     assert code == 0
     assert "11 heel strikes" in out
+
+
+def test_jargon_in_the_plans_is_explained(capsys):
+    from helpers import CONFIG_DIR
+
+    code, out, _ = run_cli(capsys, "plan", "--distance", "0.3")
+    assert code == 0 and "RV: walking speed over leg length" in out
+    code, out, _ = run_cli(capsys, "plan", "--terrain", CONFIG_DIR / "terrain" / "kerb.toml")
+    assert code == 0 and "(mid double support, MDS)" in out
+    assert not any(line.startswith("MDS") for line in out.splitlines())
