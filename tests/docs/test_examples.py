@@ -29,6 +29,7 @@ def run_in_order(commands, folder):
     return ran
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("page", WITH_COMMANDS, ids=lambda p: p.name)
 def test_the_commands_of_a_page_do_what_it_says(page, tmp_path):
     prepare_folder(tmp_path)

@@ -21,6 +21,7 @@ def test_the_docs_hold_figures():
     assert len(REGIONS) >= 8 and len(COMMANDS) >= 4
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", COMMANDS)
 def test_documented_figures_are_what_a_fresh_run_prints(command):
     fresh = run_figure_command(command)
