@@ -191,6 +191,55 @@ def height(pieces, x):
     return out
 
 
+def heights_under(pieces, x):
+    """``height`` for an array of any shape, vectorised (at an edge: the higher side)."""
+    x = np.asarray(x, dtype=float)
+    out = np.full(x.shape, -np.inf)
+    for start, end, h in pieces:
+        out = np.where((x >= start - 1e-12) & (x <= end + 1e-12), np.maximum(out, h), out)
+    return out
+
+
+def fk_foot(cfg, q, root):
+    """Ankle, heel and toe in the world of one leg from hip, knee, ankle flexion (the tests' own kinematics,
+    docs/gait-model.md section 1; the heel is heel_back_m behind the ankle's projection on the sole)."""
+    g = cfg.geometry
+    h, k, a = q[:, 0], q[:, 1], q[:, 2]
+    ankle = root + np.column_stack([g.thigh_m * np.sin(h) + g.shank_m * np.sin(h - k),
+                                    -g.thigh_m * np.cos(h) - g.shank_m * np.cos(h - k)])
+    p = h - k + a  # sole pitch, toe up
+    along_sole = np.column_stack([np.cos(p), np.sin(p)])
+    heel = ankle + g.ankle_height_m * np.column_stack([np.sin(p), -np.cos(p)]) - g.heel_back_m * along_sole
+    return ankle, heel, heel + g.foot_m * along_sole
+
+
+def swing_clearances(cfg, trajectory, treads=()) -> list[tuple[float, float, float]]:
+    """Per swing of either foot, by the tests' own kinematics and docs/gait.md's rule: (forward travel m, least
+    height of the whole sole above the ground under it while the ankle covers 10% to 90% of its forward travel,
+    share of the swing's time before the sole is 0.2 mm off the ground). A swing runs between two frames in
+    which the foot's lowest point is on the ground (within 0.01 mm)."""
+    pieces = surface_pieces(treads)
+    out = []
+    for side in (0, 1):
+        ankle, heel, toe = fk_foot(cfg, trajectory.angles_rad[:, 3 * side:3 * side + 3], trajectory.root_m)
+        u = np.linspace(0.0, 1.0, 21)
+        sole = heel[:, None, :] + u[None, :, None] * (toe - heel)[:, None, :]
+        gap = (sole[..., 1] - heights_under(pieces, sole[..., 0])).min(axis=1)
+        down = np.flatnonzero(gap <= 1e-5)
+        for a, b in zip(down[:-1], down[1:]):
+            if b - a < 2:
+                continue
+            travel = ankle[b, 0] - ankle[a, 0]
+            if travel < 1e-3:
+                continue  # a foot set down where it was lifted (a step of 0) does not move forward
+            progress = (ankle[a:b + 1, 0] - ankle[a, 0]) / travel
+            moving = (progress >= 0.1) & (progress <= 0.9)
+            up = int(np.argmax(gap[a:b + 1] > 2e-4))
+            out.append((travel, gap[a:b + 1][moving].min(), (trajectory.t_s[a + up] - trajectory.t_s[a])
+                        / (trajectory.t_s[b] - trajectory.t_s[a])))
+    return out
+
+
 # --- the simulated robot (gaitbot.sim.physics.SimRobot)
 
 

@@ -24,6 +24,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
 
+from gaitbot.app.progress import progress  # noqa: E402
 from gaitbot.gait import TABLE1_LEG, OnlineWalker, generate_walk  # noqa: E402
 from gaitbot.gait.step_length import StepLengthInverse, boulic_step_length, step_length_to_rv_bisection  # noqa: E402
 
@@ -98,6 +99,14 @@ def bench_gait() -> None:
     print(f"  paper's bisection (tolerance 0.01): {_us(bisect_times)}")
 
 
+def frame_counter(bar):
+    """A Streamer's on_frame that moves the bar now and then (a bar drawn every frame would cost the loop)."""
+    def on_frame(k: int, stats) -> None:
+        if k % 30 == 0:
+            bar.update(k + 1 - bar.n)
+    return on_frame
+
+
 def bench_stream(seconds: float) -> None:
     from gaitbot.bus.factory import make_bus
     from gaitbot.stream.clock import MonotonicClock
@@ -113,8 +122,8 @@ def bench_stream(seconds: float) -> None:
     frames = trajectory_ticks(config, trajectory)[: int(seconds * settings.rate_hz)]
     bus = make_bus(config.bus.backend, config.bus.protocol, "mock", config.bus.baudrate, config.models_by_id,
                    dry_run=True)
-    with bus:
-        stats = Streamer(bus, config.ids, 1.0 / settings.rate_hz, MonotonicClock()).run(frames)
+    with bus, progress("streaming in real time", total=len(frames), unit="frame") as bar:
+        stats = Streamer(bus, config.ids, 1.0 / settings.rate_hz, MonotonicClock(), frame_counter(bar)).run(frames)
     print(f"streaming, {len(frames) / settings.rate_hz:.0f} s real-time dry run at {settings.rate_hz:g} Hz "
           f"({config.name}, Dynamixel 2.0 packets on the mock bus):")
     print(f"  {stats.summary()}")

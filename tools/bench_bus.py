@@ -9,6 +9,7 @@ servo (sync read where the protocol has one). Beside it, the wire limit from the
 
     python tools/bench_bus.py              # about 20 s
     python tools/bench_bus.py --seconds 0.5
+    python tools/bench_bus.py --markdown    # the wire limits of docs/benchmarks.md (tools/figures.py)
 
 The pty does not pace bytes at the baud rate, so the measured rate is what the host (Python, the
 SDK's polling receive loop, the emulator) sustains; the real bus is bounded by the wire column.
@@ -40,7 +41,9 @@ def measure(protocol: str, n_servos: int, read_back: bool, seconds: float) -> fl
     model = servo_model(name)
     models = {i: model for i in range(1, n_servos + 1)}
     with se.ServoEmulator(se.EmulatorConfig(backend, version, models)) as emulator:
-        bus = make_bus(backend, version, emulator.path, 1_000_000, models, dry_run=False)
+        # throughput, not latency, is measured: the emulator's thread shares the GIL with the bus, so a busy
+        # host can hold a reply past the SDK's 34 ms timeout; a generous timeout keeps that from ending the run
+        bus = make_bus(backend, version, emulator.path, 1_000_000, models, dry_run=False, reply_timeout_ms=500)
         with bus:
             ids = list(models)
             frames, start = 0, time.perf_counter()
@@ -59,10 +62,26 @@ def wire_limit_hz(protocol: str, n_servos: int, baudrate: int, read_back: bool) 
     return 1.0 / frame_budget(backend, version, name, n_servos, baudrate, read_back).wire_time_s
 
 
+def wire_markdown() -> str:
+    """The wire limits of each protocol (computed from packet sizes: no timing), as docs/benchmarks.md's table."""
+    names = {"dxl2": "Dynamixel 2.0", "dxl1": "Dynamixel 1.0", "feetech-sts": "Feetech STS", "feetech-scs": "Feetech SCS"}
+    lines = ["| protocol | servos | wire Hz at 1 Mbaud (w / w+r) | wire Hz at 57,600 (w / w+r) |", "|---|---|---|---|"]
+    for protocol, name in names.items():
+        for n in (6, 12):
+            fast = [wire_limit_hz(protocol, n, 1_000_000, r) for r in (False, True)]
+            slow = [wire_limit_hz(protocol, n, 57_600, r) for r in (False, True)]
+            lines.append(f"| {name} | {n} | {fast[0]:.0f} / {fast[1]:.0f} | {slow[0]:.1f} / {slow[1]:.1f} |")
+    return "<!-- figure bus-wire -->\n" + "\n".join(lines) + "\n<!-- /figure -->"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=1.0, help="seconds per measurement (default 1)")
+    parser.add_argument("--markdown", action="store_true", help="print the wire limits as the docs' table")
     args = parser.parse_args(argv)
+    if args.markdown:
+        print(wire_markdown())
+        return 0
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}")
     print(f"{'protocol':12} {'servos':>6} {'frame':>13} {'pty Hz':>8} {'wire Hz 1M':>11} {'wire Hz 57600':>14}")
     for protocol in ("dxl2", "dxl1", "feetech-sts", "feetech-scs"):

@@ -28,6 +28,7 @@ except ImportError:  # run from a checkout without installing
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
     from gaitbot.bus.base import Bus
 
+from gaitbot.app.progress import progress
 from gaitbot.stream.clock import MonotonicClock
 from gaitbot.stream import Streamer
 
@@ -77,10 +78,14 @@ def main(argv: list[str] | None = None) -> int:
     frame_count = max(1, round(args.seconds * args.rate_hz))
     frames = bench_frames(frame_count, args.joints, args.rate_hz)
     clock = MonotonicClock()
-    streamer = Streamer(InMemoryBus(ids), ids, 1.0 / args.rate_hz, clock)
     print(f"Streaming {frame_count} frames to {args.joints} in-memory servos at {args.rate_hz:g} Hz "
           f"({frame_count / args.rate_hz:.1f} s, spin {clock.spin_s * 1e3:.1f} ms) ...", flush=True)
-    stats = streamer.run(frames)
+    with progress("streaming in real time", total=frame_count, unit="frame") as bar:
+        def on_frame(k: int, _stats) -> None:  # now and then: a bar drawn every frame would cost the loop
+            if k % 30 == 0:
+                bar.update(k + 1 - bar.n)
+
+        stats = Streamer(InMemoryBus(ids), ids, 1.0 / args.rate_hz, clock, on_frame).run(frames)
 
     us = 1e6
     print(f"machine: {platform.platform()}, {platform.processor() or platform.machine()}, "

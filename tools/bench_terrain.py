@@ -3,6 +3,7 @@
     python tools/bench_terrain.py                    # both parts
     python tools/bench_terrain.py stairs [--rise 0.035 --going 0.16 --repeat 3]
     python tools/bench_terrain.py search             # every example course of every shipped robot
+    python tools/bench_terrain.py search --markdown  # the search's figures for docs/terrain.md (tools/figures.py)
 
 stairs: foothold planning time, whole-walk generation time (footholds, grid searches, segments,
 every frame) and frames per second, and the grid search's cells scored against the 625 of a
@@ -27,6 +28,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from gaitbot.app.progress import progress  # noqa: E402
 from gaitbot.gait.terrain.footholds import plan_footholds  # noqa: E402
 from gaitbot.gait.terrain.model import Terrain, Tread  # noqa: E402
 from gaitbot.gait.terrain.walk import plan_terrain_walk, terrain_limits  # noqa: E402
@@ -92,42 +94,76 @@ def example_courses():
                 yield name, path
 
 
-def bench_search() -> None:
+def search_rows():
+    """Per example course: (robot, course, MDS points, two-level cost, 25x25 cost, worst ratio, cells scored,
+    cells of full 5x5x5x5 searches, 25x25 cells scored, middle-of-region cost, two-level cost at the same points,
+    middles out of reach); and every point's ratio of two-level to brute force."""
     robots: dict[str, Robot] = {}
-    all_ratios = []
+    rows, all_ratios = [], []
+    courses = list(example_courses())
+    with progress("grid search against 25 x 25", total=len(courses), unit="course") as bar:
+        for name, path in courses:
+            robot = robots.setdefault(name, Robot(name))
+            walk, _ = robot.walk(load_course(path))
+            fast_sum = full_sum = middle_sum = paired_sum = 0.0
+            fast_cells = full_cells = middle_out = 0
+            worst = 1.0
+            for problem in walk.search_problems:
+                fast = problem.search()
+                full = problem.brute_force(25)
+                fast_sum += fast.cost
+                full_sum += full.cost
+                if np.isfinite(fast.centre_cost):
+                    middle_sum += fast.centre_cost
+                    paired_sum += fast.cost
+                else:
+                    middle_out += 1
+                fast_cells += fast.evaluated
+                full_cells += full.evaluated
+                ratio = fast.cost / full.cost if full.cost > 0 else 1.0
+                worst = max(worst, ratio)
+                all_ratios.append(ratio)
+            count = len(walk.search_problems)
+            rows.append((name, path.stem, count, fast_sum, full_sum, worst, fast_cells, 625 * count, full_cells,
+                         middle_sum, paired_sum, middle_out))
+            bar.update(1)
+    return rows, np.array(all_ratios)
+
+
+def bench_search(as_markdown: bool = False) -> None:
+    rows, ratios = search_rows()
+    if as_markdown:
+        print(search_markdown(rows, ratios))
+        return
     print("grid search on the example courses (costs: weighted squared joint accelerations, (rad/s^2)^2 s, summed over")
     print("the MDS points; 'middle': the middle of each region where the legs can take it, against the two-level")
     print("search at the same points):")
     print(f"  {'robot':14s} {'course':7s} {'MDS':>4s} {'two-level':>10s} {'25x25':>10s} {'worst ratio':>11s} "
           f"{'cells scored':>14s} {'25x25 cells':>11s}   middle vs two-level")
-    for name, path in example_courses():
-        robot = robots.setdefault(name, Robot(name))
-        walk, _ = robot.walk(load_course(path))
-        fast_sum = full_sum = middle_sum = paired_sum = 0.0
-        fast_cells = full_cells = middle_out = 0
-        worst = 1.0
-        for problem in walk.search_problems:
-            fast = problem.search()
-            full = problem.brute_force(25)
-            fast_sum += fast.cost
-            full_sum += full.cost
-            if np.isfinite(fast.centre_cost):
-                middle_sum += fast.centre_cost
-                paired_sum += fast.cost
-            else:
-                middle_out += 1
-            fast_cells += fast.evaluated
-            full_cells += full.evaluated
-            ratio = fast.cost / full.cost if full.cost > 0 else 1.0
-            worst = max(worst, ratio)
-            all_ratios.append(ratio)
-        count = len(walk.search_problems)
-        middle = f"{middle_sum:.1f} vs {paired_sum:.1f}" + (f" ({middle_out} middles out of reach)" if middle_out else "")
-        print(f"  {name:14s} {path.stem:7s} {count:4d} {fast_sum:10.1f} {full_sum:10.1f} {worst:11.3f} "
-              f"{fast_cells:5d} of {625 * count:5d} {full_cells:11d}   {middle}")
-    ratios = np.array(all_ratios)
+    for name, course, count, fast, full, worst, cells, of, full_cells, middle, paired, out in rows:
+        middle_text = f"{middle:.1f} vs {paired:.1f}" + (f" ({out} middles out of reach)" if out else "")
+        print(f"  {name:14s} {course:7s} {count:4d} {fast:10.1f} {full:10.1f} {worst:11.3f} "
+              f"{cells:5d} of {of:5d} {full_cells:11d}   {middle_text}")
     print(f"  all {len(ratios)} MDS points: two-level / 25x25 median {np.median(ratios):.4f}, worst {ratios.max():.4f}, "
           f"{np.mean(ratios <= 1.05) * 100:.0f}% within 5%")
+
+
+def search_markdown(rows, ratios) -> str:
+    table = ["| robot, course | MDS points | two-level | 25 x 25 | worst ratio | cells scored (two-level / 25 x 25) | "
+             "middle of region vs two-level |", "|---|---|---|---|---|---|---|"]
+    for name, course, count, fast, full, worst, cells, of, full_cells, middle, paired, out in rows:
+        reach = f" ({out} middle{'s' if out != 1 else ''} out of reach)" if out else ""
+        table.append(f"| {name.split('-')[0]} {course} | {count} | {fast:.1f} | {full:.1f} | {worst:.3f} | "
+                     f"{cells} / {full_cells} of {of} | {middle:.1f} vs {paired:.1f}{reach} |")
+    outs = sum(r[11] for r in rows)
+    factors = [r[9] / r[10] for r in rows if r[10] > 0]
+    summary = (f"Over all {len(ratios)} points the two-level search's cost is {np.median(ratios):.3f} times the brute "
+               f"force's at the median and {ratios.max():.3f} at worst ({np.mean(ratios <= 1.05) * 100:.0f}% within 5%), "
+               f"scoring about {sum(r[6] for r in rows) / sum(r[8] for r in rows):.2f} of its cells; the middle of the "
+               f"region is out of the legs' reach at {outs} of them and costs {min(factors):.0f} to "
+               f"{max(factors):.0f} times more elsewhere (summed per course).")
+    return (f"<!-- figure terrain-search -->\n" + "\n".join(table) + "\n<!-- /figure -->\n"
+            f"<!-- figure terrain-search-summary -->\n{summary}\n<!-- /figure -->")
 
 
 def main(argv=None) -> int:
@@ -136,7 +172,11 @@ def main(argv=None) -> int:
     parser.add_argument("--rise", type=float, default=0.035)
     parser.add_argument("--going", type=float, default=0.16)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--markdown", action="store_true", help="search: print the docs' figures (tools/figures.py)")
     args = parser.parse_args(argv)
+    if args.markdown:
+        bench_search(as_markdown=True)
+        return 0
     print(f"machine: {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
           f"numpy {np.__version__}")
     for part in args.parts:

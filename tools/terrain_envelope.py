@@ -3,6 +3,7 @@
     python tools/terrain_envelope.py                       # verify each robot's [terrain] table, print it
     python tools/terrain_envelope.py --measure             # bisect rise, drop and gap with the generator
     python tools/terrain_envelope.py --random 40 --seed 1  # also walk 40 random courses inside the envelope
+    python tools/terrain_envelope.py --markdown            # the configs' envelopes as docs/terrain.md's table
 
 A value "walks" when the planner finds footholds and the generated walk passes ``gaitbot check``'s
 limits (positions, velocities, accelerations) on every course of its family:
@@ -30,6 +31,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from gaitbot.app.progress import progress  # noqa: E402
 from gaitbot.check.trajectory import check_trajectory  # noqa: E402
 from gaitbot.gait.segments import GaitGenerationError  # noqa: E402
 from gaitbot.gait.terrain.envelope import StepEnvelope  # noqa: E402
@@ -151,20 +153,42 @@ def random_courses(robot: Robot, env: StepEnvelope, count: int, seed: int) -> li
     return out
 
 
+def markdown(names) -> str:
+    """The envelope table of docs/terrain.md: each robot's configured [terrain] values (what --measure found, one
+    grid step less, and what the verification walks), without walking anything."""
+    lines = ["| robot | leg | foot | max rise | max drop | min going | max ditch |", "|---|---|---|---|---|---|---|"]
+    for name in names:
+        robot = Robot(name)
+        reach, leg = robot.config.terrain, robot.geometry.leg_length
+        lines.append(f"| {robot.name} | {leg * 1000:.0f} mm | {robot.geometry.foot * 1000:.0f} mm | "
+                     f"{reach.max_rise_m * 1000:.1f} mm ({reach.max_rise_m / leg:.2f} leg) | "
+                     f"{reach.max_drop_m * 1000:.1f} mm ({reach.max_drop_m / leg:.2f} leg) | "
+                     f"{robot.shortest * 1000:.0f} mm ({robot.shortest / leg:.2f} leg) | {reach.max_gap_m * 1000:.1f} mm |")
+    return "<!-- figure terrain-envelope -->\n" + "\n".join(lines) + "\n<!-- /figure -->"
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robot", action="append", help="robot config name or path (default: every shipped one)")
     parser.add_argument("--measure", action="store_true", help="bisect the envelope instead of verifying the config's")
     parser.add_argument("--random", type=int, default=0, help="also walk this many random courses inside it")
-    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--seed", type=int, default=1, help="seed of the random courses")
+    parser.add_argument("--markdown", action="store_true", help="print the configured envelopes as the docs' table")
     args = parser.parse_args()
+    if args.markdown:
+        print(markdown(args.robot or sorted(shipped_config_names(), key=lambda n: n != "xl430-biped")))
+        return 0
     status = 0
     for name in args.robot or shipped_config_names():
         robot = Robot(name)
         t0 = time.perf_counter()
         if args.measure:
             leg = robot.geometry.leg_length
-            found = {f: bisect(robot, f, 0.4 * leg) for f in ("rise", "drop", "gap")}
+            with progress(f"{robot.name}: bisecting rise, drop, gap", total=3, unit="value") as bar:
+                found = {}
+                for family in ("rise", "drop", "gap"):
+                    found[family] = bisect(robot, family, 0.4 * leg)
+                    bar.update(1)
             env = robot.envelope(*(max(0.0, found[f] - GRID) for f in ("rise", "drop", "gap")))
             print(f"{robot.name}: walks rise {found['rise'] * 1000:.1f} mm, drop {found['drop'] * 1000:.1f} mm, "
                   f"gap {found['gap'] * 1000:.1f} mm (each alone, {time.perf_counter() - t0:.0f} s)")
@@ -177,7 +201,13 @@ def main() -> int:
             env = robot.envelope(reach.max_rise_m, reach.max_drop_m, reach.max_gap_m)
         courses = [c for family in families(robot, env).values() for c in family]
         courses += random_courses(robot, env, args.random, args.seed)
-        failures = [why for why in (robot.walks(c, env) for c in courses) if why]
+        failures = []
+        with progress(f"{robot.name}: walking courses", total=len(courses), unit="course") as bar:
+            for course in courses:
+                why = robot.walks(course, env)
+                if why:
+                    failures.append(why)
+                bar.update(1)
         leg = robot.geometry.leg_length
         print(f"{robot.name} (leg {leg * 1000:.0f} mm, foot {robot.geometry.foot * 1000:.0f} mm): "
               f"max rise {env.max_rise * 1000:.1f} mm ({env.max_rise / leg:.2f} leg), "

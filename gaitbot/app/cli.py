@@ -1,7 +1,10 @@
 """The ``gaitbot`` command line: the parser, and each subcommand handed to its module in gaitbot.app.
 
-Bad input (any ``gaitbot.errors.UserError``) prints one line and exits with status 2; a bus that
-fails outside a walk session prints one line and exits with status 1 (a traceback only with --debug).
+Exit statuses are part of the interface (docs/command-line.md): 0 success; 1 the robot or the check
+failed (a limit broken, a bus fault, a fall in the simulation); 2 bad input (any
+``gaitbot.errors.UserError`` or usage error: one line, nothing sent to a servo); 130 Ctrl-C and 143
+SIGTERM during a walk or a recording; 141 when whoever reads the output stops reading (``| head``).
+A traceback only with --debug.
 """
 
 from __future__ import annotations
@@ -9,7 +12,6 @@ from __future__ import annotations
 import os
 import signal
 import sys
-import textwrap
 import threading
 
 #: Signals that came while the command line was still being imported (the command then ends at once,
@@ -28,6 +30,7 @@ import importlib  # noqa: E402
 import warnings  # noqa: E402
 
 from gaitbot import __version__  # noqa: E402
+from gaitbot.app.help import COMMAND_HELP, DESCRIPTION, EPILOG, HelpFormatter  # noqa: E402
 from gaitbot.errors import UserError  # noqa: E402
 from gaitbot.stream.signals import StopSignals, Terminated  # noqa: E402 - light: rooms come with the commands
 
@@ -36,198 +39,225 @@ from gaitbot.stream.signals import StopSignals, Terminated  # noqa: E402 - light
 COMMANDS = {name: f"gaitbot.app.{name}" for name in ("plan", "generate", "plot", "walk", "check", "eigen", "record",
                                                      "scan", "setup", "calibrate")}
 
+#: What ``walk --dry-run`` and ``walk --sim`` walk when no steps are given: the demo (said on stderr).
+DEMO_DISTANCE_M = 0.5
+
+#: Exit status when the reader of our output went away (like a program killed by SIGPIPE: 128 + 13).
+EXIT_BROKEN_PIPE = 141
+
 CALIBRATION_HELP = ("calibration file (gaitbot calibrate) applied on top of the robot config (default: "
                     "<config stem>.calibration.toml beside the config, if there is one)")
 REPLY_TIMEOUT_HELP = "how long to wait for each status packet (default: the SDK's, about 34 ms at 1 Mbaud)"
 
 
-def _calibration(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--calibration", metavar="FILE", help=CALIBRATION_HELP)
-
-
-def _described(sub, name: str, help: str, description: str, examples: str) -> argparse.ArgumentParser:
-    """A subcommand with a description and examples in its --help."""
-    return sub.add_parser(name, help=help, description=textwrap.fill(description, 100),
-                          epilog="examples:\n" + examples, formatter_class=argparse.RawDescriptionHelpFormatter)
-
-
-def _walk_inputs(p: argparse.ArgumentParser) -> None:
-    what = p.add_mutually_exclusive_group(required=False)
-    what.add_argument("--steps", help="step lengths in metres, comma separated, e.g. 0.05,0.08,0.08")
-    what.add_argument("--distance", type=float, help="distance to walk in metres (fewest equal steps)")
-    p.add_argument("--max-step", type=float, help="longest step for --distance, metres (default: the robot's max_step_m)")
-    p.add_argument("--perturb", type=float, default=0.0, metavar="SIGMA",
-                   help="add zero-mean random noise of this standard deviation (metres) to step lengths")
-    p.add_argument("--seed", type=int, help="random seed for --perturb")
-    p.add_argument("--robot", help="robot config (a .toml path or a shipped name; default xl430-biped)")
-    _calibration(p)
-    p.add_argument("--thigh", type=float, help="thigh length in metres (overrides the robot's leg)")
-    p.add_argument("--shank", type=float, help="shank length in metres")
-    p.add_argument("--foot", type=float, help="foot length in metres")
-    p.add_argument("--clearance", type=float, help="swing-foot clearance in metres (default: the robot's)")
-    p.add_argument("--rate", type=float, help="frame rate in Hz (default: the robot's rate_hz)")
-    p.add_argument("--terrain", metavar="FILE", help="walk a terrain course (TOML, see config/terrain/) instead of "
-                   "--steps/--distance")
-
-
 class OneLineParser(argparse.ArgumentParser):
     """argparse, but a usage error is one line (the program, the error, where to look) and exit 2: no usage
-    block around it (``--help`` still prints the usage)."""
+    block around it (``--help`` still prints the usage). Subcommands' parsers are of the same class."""
 
     def error(self, message: str):  # noqa: D401 - argparse's name
         self.exit(2, f"{self.prog}: error: {' '.join(message.split())} (see {self.prog} --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = OneLineParser(prog="gaitbot", description="Walking gaits for small servo bipeds.")
-    parser.add_argument("--version", action="version", version=f"gaitbot {__version__}")
-    parser.add_argument("--debug", action="store_true", help="show tracebacks")
-    sub = parser.add_subparsers(dest="command", required=True)
+def _robot_options(p: argparse.ArgumentParser, robot_help: str) -> None:
+    p.add_argument("--robot", help=robot_help)
+    p.add_argument("--calibration", metavar="FILE", help=CALIBRATION_HELP)
 
-    p = sub.add_parser("plan", help="print the step plan")
+
+def _leg_options(p: argparse.ArgumentParser, what: str = "overrides the robot's leg") -> None:
+    p.add_argument("--thigh", type=float, metavar="M", help=f"thigh length in metres ({what})")
+    p.add_argument("--shank", type=float, metavar="M", help=f"shank length in metres ({what})")
+    p.add_argument("--foot", type=float, metavar="M", help=f"foot length, heel to toe, in metres ({what})")
+
+
+def _walk_inputs(p: argparse.ArgumentParser, demo: bool = False) -> None:
+    what = p.add_mutually_exclusive_group(required=False)
+    what.add_argument("--steps", metavar="A,B,...", help="step lengths in metres, comma separated, e.g. 0.05,0.08,0.08")
+    what.add_argument("--distance", type=float, metavar="M",
+                      help="distance to walk in metres, in the fewest equal steps"
+                      + (f" (with --dry-run or --sim and no other source: {DEMO_DISTANCE_M:g}, the demo)"
+                         if demo else ""))
+    p.add_argument("--max-step", type=float, metavar="M",
+                   help="longest step for --distance, metres (default: the robot's max_step_m)")
+    p.add_argument("--perturb", type=float, default=0.0, metavar="SIGMA",
+                   help="add zero-mean random noise of this standard deviation (metres) to step lengths")
+    p.add_argument("--seed", type=int, help="random seed for --perturb (default: a different walk each time)")
+    _robot_options(p, "robot config: a .toml path or a shipped name (default xl430-biped)")
+    _leg_options(p)
+    p.add_argument("--clearance", type=float, metavar="M",
+                   help="how high the whole swing sole stays above the ground while the foot moves forward, "
+                   "metres (default: the robot's clearance_m)")
+    p.add_argument("--rate", type=float, metavar="HZ", help="frame rate in Hz (default: the robot's rate_hz)")
+    p.add_argument("--terrain", metavar="FILE", help="walk a terrain course (TOML, see config/terrain/) instead of "
+                   "--steps/--distance")
+
+
+def _bus_options(p: argparse.ArgumentParser, dry_run_help: str) -> None:
+    p.add_argument("--port", help="serial port, e.g. /dev/ttyUSB0 (default: the robot config's; not with --dry-run)")
+    p.add_argument("--dry-run", action="store_true", help=dry_run_help)
+    p.add_argument("--reply-timeout-ms", type=float, metavar="MS", help=REPLY_TIMEOUT_HELP)
+
+
+def _command(sub, name: str, **kwargs) -> argparse.ArgumentParser:
+    text = COMMAND_HELP[name]
+    return sub.add_parser(name.split()[-1], help=text.summary, description=text.description, epilog=text.epilog,
+                          formatter_class=HelpFormatter, **kwargs)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser; ``parser.commands`` maps each subcommand to its own parser (its errors print its usage)."""
+    parser = OneLineParser(prog="gaitbot", description=DESCRIPTION, epilog=EPILOG, formatter_class=HelpFormatter)
+    parser.add_argument("--version", action="version", version=f"gaitbot {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    parser.commands = {}
+
+    p = parser.commands["plan"] = _command(sub, "plan")
     _walk_inputs(p)
     p.add_argument("--json", action="store_true", help="print the plan as one JSON object")
 
-    p = sub.add_parser("generate", help="write the trajectory to CSV or NPZ")
+    p = parser.commands["generate"] = _command(sub, "generate")
     _walk_inputs(p)
-    p.add_argument("-o", "--output", required=True, help="walk.csv or walk.npz")
+    p.add_argument("-o", "--output", required=True, help="walk.csv or walk.npz (file formats: docs/file-formats.md)")
 
-    p = sub.add_parser("plot", help="draw a trajectory file to a PNG")
-    p.add_argument("file", help="trajectory (.csv or .npz)")
-    p.add_argument("-o", "--output", required=True, help="picture file, e.g. walk.png")
-    p.add_argument("--robot", help="robot config whose leg drew the trajectory (default xl430-biped)")
-    _calibration(p)
-    p.add_argument("--thigh", type=float)
-    p.add_argument("--shank", type=float)
-    p.add_argument("--foot", type=float)
-    p.add_argument("--clearance", type=float)
-    p.add_argument("--terrain", metavar="FILE", help="terrain course the trajectory walked: draw it")
+    p = parser.commands["plot"] = _command(sub, "plot")
+    p.add_argument("file", help="trajectory (.csv or .npz), or an eigen-gait model (.npz from gaitbot eigen fit)")
+    p.add_argument("-o", "--output", required=True, help="picture file, e.g. walk.png (or .svg, .pdf)")
+    _robot_options(p, "robot config whose leg walked the trajectory (default xl430-biped)")
+    _leg_options(p, "if the trajectory was made with another leg")
+    p.add_argument("--clearance", type=float, metavar="M",
+                   help="clearance line drawn on the foot heights, metres (default: the robot's clearance_m)")
+    p.add_argument("--terrain", metavar="FILE", help="terrain course the trajectory walked: draw it, and foot heights "
+                   "above it")
 
-    p = sub.add_parser("walk", help="walk the robot (or a dry run on the mock bus)")
-    _walk_inputs(p)
-    p.add_argument("--dry-run", action="store_true", help="use the mock bus: no hardware, exact packets")
-    p.add_argument("--realtime", action="store_true", help="pace a dry run at the real frame rate")
-    p.add_argument("--record", help="write every bus packet to this .jsonl file")
-    p.add_argument("--port", help="serial port (default: the robot config's)")
-    p.add_argument("--reply-timeout-ms", type=float,
-                   help="how long to wait for each status packet (default: the SDK's, about 34 ms at 1 Mbaud)")
+    p = parser.commands["walk"] = _command(sub, "walk")
+    _walk_inputs(p, demo=True)
     p.add_argument("--trajectory", metavar="FILE", help="walk a trajectory file (.csv/.npz: gaitbot generate, "
                    "eigen synth, record) instead of --steps/--distance; it streams at its own frame rate")
+    _bus_options(p, "use the mock bus under the real SDK: no hardware, and every packet exactly as a real walk sends it")
+    p.add_argument("--realtime", action="store_true",
+                   help="--dry-run: pace it at the real frame rate (default: a simulated clock, as fast as it goes)")
+    p.add_argument("--record", metavar="FILE", help="write every bus packet to this .jsonl file (gaitbot check reads it)")
     p.add_argument("--sim", action="store_true",
-                   help="walk the simulated robot (MuJoCo, the sim extra) and measure whether it really walks")
+                   help="walk the simulated robot (MuJoCo) and measure whether it really walks")
     p.add_argument("--free-pitch", action="store_true", help="--sim: let the torso pitch freely (default: held by a boom)")
     p.add_argument("--boom", action="store_true",
                    help="the robot walks on a boom: accept a walk that would tip a free-standing robot")
     p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (side view)")
     p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
 
-    p = sub.add_parser("check", help="check a trajectory or a recorded run against the robot's limits")
+    p = parser.commands["check"] = _command(sub, "check")
     p.add_argument("file", help="trajectory (.csv, .npz) or bus recording (.jsonl)")
-    p.add_argument("--robot", help="robot config (default: a recording's own robot, else xl430-biped)")
-    _calibration(p)
+    _robot_options(p, "robot config (default: a recording's own robot, else xl430-biped)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
-    p.add_argument("--margin-deg", type=float, default=0.0, help="warn within this many degrees of a limit")
+    p.add_argument("--margin-deg", type=float, default=0.0, metavar="DEG",
+                   help="warn within this many degrees of a limit (default 0)")
     p.add_argument("--boom", action="store_true",
                    help="the robot walks on a boom: do not check its balance (ZMP against the support polygon)")
     p.add_argument("--allow-partial", action="store_true",
                    help="recordings: ignore a truncated last line (with a warning), e.g. after a crash")
 
-    p = sub.add_parser("eigen", help="eigen-gaits (seed 004): fit a model to example walks, synthesise walks")
-    eigen = p.add_subparsers(dest="eigen_command", required=True)
-    q = eigen.add_parser("fit", help="fit an eigen-gait model to example trajectory files")
+    p = parser.commands["eigen"] = _command(sub, "eigen")
+    eigen = p.add_subparsers(dest="eigen_command", required=True, metavar="{fit,synth}")
+    q = parser.commands["eigen fit"] = _command(eigen, "eigen fit")
     q.add_argument("examples", nargs="+", help="trajectory files (.npz or .csv), one walk each")
     q.add_argument("-o", "--output", required=True, help="model file, e.g. model.npz")
-    q.add_argument("--robot", help="robot config whose leg walked the examples (default xl430-biped)")
-    _calibration(q)
+    _robot_options(q, "robot config whose leg walked the examples (default xl430-biped); the model remembers it")
+    _leg_options(q, "when the examples were walked with another leg than the robot's; the model remembers it")
     q.add_argument("--samples", type=int, default=100, help="samples per resampled cycle (default 100)")
-    q.add_argument("--basis", choices=("fourier", "bspline"), default="fourier")
-    q.add_argument("--n-basis", type=int, default=31, help="basis functions per channel (odd for fourier)")
-    q.add_argument("--roughness", type=float, default=0.0, help="roughness penalty on the second derivative")
-    q.add_argument("--pose-variance", type=float, default=0.95, help="share of pose variance the pose PCA keeps "
-                   "at least (default 0.95)")
-    q.add_argument("--pose-tolerance-deg", type=float, default=0.5, help="and more pose axes until no example pose "
-                   "moves by more than this when projected (default 0.5; inf: the variance rule alone)")
-    q.add_argument("--variance", type=float, default=0.95, help="share of variance the eigen-motions kept explain")
-    q.add_argument("--components", type=int, help="keep exactly this many eigen-motions")
-    q.add_argument("--align", choices=("dtw", "none"), default="dtw", help="time alignment of the cycles")
-    q.add_argument("--label-degree", type=int, default=2, help="degree of the step-length regression")
-    q = eigen.add_parser("synth", help="synthesise a walk from an eigen-gait model")
-    q.add_argument("model", help="model file from `gaitbot eigen fit`")
-    q.add_argument("--step-length", type=float, required=True, help="step length in metres")
-    q.add_argument("--to-step-length", type=float, help="change the step length smoothly to this over the cycles")
+    q.add_argument("--basis", choices=("fourier", "bspline"), default="fourier",
+                   help="functions the cycles are fitted with: fourier for periodic walking (default), bspline for "
+                   "motion that does not repeat")
+    q.add_argument("--n-basis", type=int, default=31, help="basis functions per channel (odd for fourier; default 31)")
+    q.add_argument("--roughness", type=float, default=0.0,
+                   help="penalty on the fitted curves' second derivative: larger is smoother (default 0)")
+    q.add_argument("--pose-variance", type=float, default=0.95, metavar="SHARE",
+                   help="share of the pose variance the pose PCA keeps at least (default 0.95)")
+    q.add_argument("--pose-tolerance-deg", type=float, default=0.5, metavar="DEG",
+                   help="and more pose axes until no example pose moves by more than this when projected "
+                   "(default 0.5; inf: the variance rule alone)")
+    q.add_argument("--variance", type=float, default=0.95, metavar="SHARE",
+                   help="share of the variance the eigen-motions kept explain (default 0.95)")
+    q.add_argument("--components", type=int, metavar="N", help="keep exactly this many eigen-motions")
+    q.add_argument("--align", choices=("dtw", "none"), default="dtw",
+                   help="time alignment of the cycles: dynamic time warping (default) or none")
+    q.add_argument("--label-degree", type=int, default=2, metavar="N",
+                   help="degree of the polynomial that maps step length to the model's coefficients (default 2)")
+    q = parser.commands["eigen synth"] = _command(eigen, "eigen synth")
+    q.add_argument("model", help="model file from gaitbot eigen fit")
+    q.add_argument("--step-length", type=float, required=True, metavar="M", help="step length in metres")
+    q.add_argument("--to-step-length", type=float, metavar="M",
+                   help="change the step length smoothly to this over the cycles")
     q.add_argument("--cycles", type=int, default=3, help="synthesised cycles (two steps each; default 3)")
-    q.add_argument("--components", type=int, help="eigen-motions to use (default: those the model kept)")
-    q.add_argument("--pose-deg", help="six joint angles in degrees the motion must pass through")
-    q.add_argument("--pose-time", type=float, help="seconds into each synthesised cycle for --pose-deg")
-    q.add_argument("--robot", help="robot config (default xl430-biped)")
-    _calibration(q)
+    q.add_argument("--components", type=int, metavar="N", help="eigen-motions to use (default: those the model kept)")
+    q.add_argument("--pose-deg", metavar="H,K,A,H,K,A",
+                   help="six joint angles in degrees (hip, knee, ankle left, then right) the motion must pass through")
+    q.add_argument("--pose-time", type=float, metavar="S", help="seconds into each synthesised cycle for --pose-deg")
+    _robot_options(q, "robot config (default: the robot the model was fitted for)")
+    _leg_options(q, "must be the leg the model was fitted with")
     q.add_argument("-o", "--output", required=True, help="walk.csv or walk.npz")
 
-    p = sub.add_parser("record", help="record a motion made by hand: torque off, positions read to a trajectory CSV")
-    p.add_argument("--robot", help="robot config (a .toml path or a shipped name; default xl430-biped)")
-    _calibration(p)
+    p = parser.commands["record"] = _command(sub, "record")
+    _robot_options(p, "robot config: a .toml path or a shipped name (default xl430-biped)")
     p.add_argument("-o", "--output", required=True, help="trajectory CSV, written as it is read, e.g. demo.csv")
-    p.add_argument("--duration", type=float, help="seconds to record (default: until Ctrl-C)")
+    p.add_argument("--duration", type=float, metavar="S", help="seconds to record (default: until Ctrl-C)")
     p.add_argument("--yes", action="store_true", help="turn torque off without asking")
     p.add_argument("--hold", action="store_true", help="at the end, hold the last pose (torque on) instead of "
                    "leaving torque off")
-    p.add_argument("--port", help="serial port (default: the robot config's)")
-    p.add_argument("--dry-run", action="store_true", help="record from the mock bus (needs --duration)")
-    p.add_argument("--reply-timeout-ms", type=float,
-                   help="how long to wait for each status packet (default: the SDK's, about 34 ms at 1 Mbaud)")
+    _bus_options(p, "record from the mock bus (needs --duration)")
 
-    p = _described(
-        sub, "scan", "list every servo that answers, at every baud rate",
-        "Ping every id at every baud rate of the configured protocol (or --baud) and list each servo that answers: "
-        "id, baud rate, model, firmware, present position (ticks and as its joint's angle), input voltage, "
-        "temperature, load, torque and hardware errors in words; then the configured joints that did not answer. "
-        "Reads only. Exit 0 when every configured joint answered as configured, else 1.",
-        "  gaitbot scan --robot config/xl430-biped.toml --port /dev/ttyUSB0\n"
-        "  gaitbot scan --robot ax12a-biped --baud 1000000 --json\n"
-        "  gaitbot scan --dry-run")
-    p.add_argument("--robot", help="robot config: its protocol, and the joints to match (default xl430-biped)")
-    _calibration(p)
-    p.add_argument("--port", help="serial port (default: the robot config's)")
+    p = parser.commands["scan"] = _command(sub, "scan")
+    _robot_options(p, "robot config: its protocol, and the joints to match (default xl430-biped)")
     p.add_argument("--baud", type=int, help="scan this baud rate only (default: every rate a servo of the "
                    "configured protocol can run at)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
-    p.add_argument("--reply-timeout-ms", type=float, help=REPLY_TIMEOUT_HELP + "; a short one (5) speeds up "
-                   "Protocol 1.0, which pings 254 ids one by one at each rate")
-    p.add_argument("--dry-run", action="store_true", help="scan the mock bus (the config's servos at its baud rate)")
+    _bus_options(p, "scan the mock bus (the config's servos at its baud rate)")
 
-    p = _described(
-        sub, "setup", "give new servos, one at a time, the config's ids and baud rate",
-        "For each joint (or each --joint), asks you to connect only that joint's servo, finds it at any id and any "
-        "baud rate its model can run at, and writes the joint's id and the config's baud rate (torque off, the "
-        "Feetech EEPROM lock, ID, Baud Rate: nothing else), then reads them back. Refuses (exit 2, nothing "
-        "written) when more than one servo answers or the servo is not the config's model.",
-        "  gaitbot setup --robot config/xl430-biped.toml --port /dev/ttyUSB0\n"
-        "  gaitbot setup --robot ax12a-biped --joint knee_pitch_left --yes --reply-timeout-ms 5")
-    p.add_argument("--robot", help="robot config: the ids, models and baud rate to give (default xl430-biped)")
-    _calibration(p)
+    p = parser.commands["setup"] = _command(sub, "setup")
+    _robot_options(p, "robot config: the ids, models and baud rate to give (default xl430-biped)")
     p.add_argument("--joint", action="append", metavar="NAME", help="set up this joint only (repeat for several; "
                    "default: every joint, in the config's order)")
     p.add_argument("--port", help="serial port (default: the robot config's)")
     p.add_argument("--yes", action="store_true", help="do not wait for Enter: the servo is already connected")
-    p.add_argument("--reply-timeout-ms", type=float, help=REPLY_TIMEOUT_HELP + "; a short one (5) speeds up the "
-                   "search, which tries every id at every baud rate")
+    p.add_argument("--reply-timeout-ms", type=float, metavar="MS", help=REPLY_TIMEOUT_HELP + "; a short one (5) "
+                   "speeds up the search, which tries every id at every baud rate")
 
-    p = _described(
-        sub, "calibrate", "measure each joint's zero tick and direction into a calibration file",
-        "Torque off; you hold the robot in its zero pose (legs straight, feet flat) and press Enter: the present "
-        "positions become the zero ticks. Then, joint by joint, you bend the joint in its positive direction "
-        "(told in words) and press Enter: the sign of the change is its direction, the size is checked against "
-        "the configured limits. Writes the calibration file, which every command applies on top of the config "
-        "(--calibration FILE, or <config stem>.calibration.toml beside the config). Writes only Torque Enable = 0 "
-        "to the servos.",
-        "  gaitbot calibrate --robot robots/mybot.toml -o robots/mybot.calibration.toml\n"
-        "  gaitbot walk --robot robots/mybot.toml --calibration mybot.calibration.toml --distance 0.5")
+    p = parser.commands["calibrate"] = _command(sub, "calibrate")
     p.add_argument("--robot", help="robot config (default xl430-biped)")
     p.add_argument("-o", "--output", required=True, help="calibration file to write (.toml)")
     p.add_argument("--port", help="serial port (default: the robot config's)")
     p.add_argument("--yes", action="store_true", help="turn torque off without asking")
-    p.add_argument("--reply-timeout-ms", type=float, help=REPLY_TIMEOUT_HELP)
+    p.add_argument("--reply-timeout-ms", type=float, metavar="MS", help=REPLY_TIMEOUT_HELP)
     return parser
+
+
+def check_sources(parser: argparse.ArgumentParser, args) -> None:
+    """plan, generate and walk need exactly one source of steps; a walk on the mock bus or the simulated robot
+    without one walks the demo, and says so."""
+    if args.command not in ("plan", "generate", "walk"):
+        return
+    own = parser.commands[args.command]
+    sources = [name for name in ("steps", "distance", "terrain", "trajectory") if getattr(args, name, None) is not None]
+    if len(sources) > 1:
+        own.error(f"give one of --{' / --'.join(sources)}, not several")
+    if sources:
+        return
+    if args.command == "walk" and (args.dry_run or args.sim):
+        args.distance = DEMO_DISTANCE_M
+        args.demo = True  # said by the walk once its other options are found good (app/walk.py)
+        return
+    extra = " or --trajectory" if args.command == "walk" else ""
+    own.error(f"give --steps, --distance or --terrain{extra} (e.g. --distance 1.0)")
+
+
+def _closed_output() -> int:
+    """Our reader went away (``gaitbot check --json x | head -1``): stop quietly. Further writes to stdout
+    (at exit, its flush) go to /dev/null instead of raising again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    return EXIT_BROKEN_PIPE
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -257,20 +287,15 @@ def main(argv: list[str] | None = None) -> int:
 def _main(argv: list[str] | None, signals: StopSignals) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    sources = [name for name in ("steps", "distance", "terrain", "trajectory") if getattr(args, name, None) is not None]
-    if args.command in ("plan", "generate", "walk") and len(sources) > 1:
-        parser.error(f"{args.command}: give one of --{' / --'.join(sources)}, not several")
-    if args.command in ("plan", "generate", "walk") and not sources:
-        if args.command == "walk" and (args.dry_run or args.sim):
-            args.distance = 0.5  # the built-in demo: half a metre on the mock bus or the simulated robot
-        else:
-            parser.error(f"{args.command}: give --steps or --distance")
+    check_sources(parser, args)
     if not args.debug:  # an error is one line: no RuntimeWarning or library warning around it (--debug shows them)
         warnings.simplefilter("ignore")
     from gaitbot.bus.base import BusError  # imported here: the bus room brings the vendor SDKs and numpy
 
     try:
         return importlib.import_module(COMMANDS[args.command]).run(args)
+    except BrokenPipeError:
+        return _closed_output()
     except (KeyboardInterrupt, Terminated):  # before or after a session (a session handles its own)
         if args.debug:
             raise
@@ -283,12 +308,6 @@ def _main(argv: list[str] | None, signals: StopSignals) -> int:
             raise
         print(f"gaitbot {args.command}: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return exc.exit_status
-    except BrokenPipeError:  # the reader of our output went away (``| head``): nothing more to say to anyone
-        try:
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        except OSError:
-            pass
-        return 1
     except OSError as exc:  # a file named on the command line that the OS refuses (a name too long, a loop ...)
         if args.debug:
             raise

@@ -16,6 +16,7 @@ warning says so and the exit status is 1.
 
 from __future__ import annotations
 
+import argparse
 import math
 import sys
 from pathlib import Path
@@ -26,10 +27,11 @@ from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, cyc
                                 synthesize_walk, walk_label)
 from gaitbot.gait.joints import PITCH_JOINTS
 from gaitbot.gait.trajectory import MAX_ANGLE_DEG, Trajectory
-from gaitbot.app.options import UsageError, check_output_path, load_robot, write_output
+from gaitbot.app.options import UsageError, check_output_path, gait_source, load_robot, write_output
+from gaitbot.app.progress import callback, progress
 from gaitbot.check.preflight import preflight
 from gaitbot.errors import UserError
-from gaitbot.robot.walk_settings import leg_geometry, walk_settings
+from gaitbot.robot.walk_settings import walk_settings
 
 POSE_TOL_DEG = 0.1
 #: Synthesised cycles one `eigen synth` may ask for (each two steps).
@@ -45,10 +47,11 @@ def run(args) -> int:
 RATE_TOL = 1e-6
 
 
-def load_examples(paths, geometry, robot_rate_hz: float | None = None, config=None):
+def load_examples(paths, geometry, robot_rate_hz: float | None = None, config=None, done=lambda n: None):
     """Example cycles of every file, each labelled with its walk's step length; and the frame rate
     (the robot's own when the files were sampled at it). With ``config``, a file that breaks the
-    robot's limits (a recording a hand took too far) is learnt from, with a warning on stderr."""
+    robot's limits (a recording a hand took too far) is learnt from, with a warning on stderr.
+    ``done(1)`` is called after each file (a progress bar)."""
     examples, rates = [], []
     for path in paths:
         trajectory = Trajectory.load(path)
@@ -61,6 +64,7 @@ def load_examples(paths, geometry, robot_rate_hz: float | None = None, config=No
         label = walk_label(cycles)
         examples += [c.__class__(c.angles_rad, c.duration_s, c.right_strike_phase, label, c.source) for c in cycles]
         rates.append(1.0 / float(np.median(np.diff(trajectory.t_s))))
+        done(1)
     if max(rates) - min(rates) > RATE_TOL * max(rates):
         raise UsageError(f"the example files have different frame rates ({min(rates):g} to {max(rates):g} Hz)")
     if robot_rate_hz is not None and abs(rates[0] - robot_rate_hz) <= RATE_TOL * robot_rate_hz:
@@ -73,23 +77,30 @@ def run_fit(args) -> int:
     if out.suffix != ".npz":
         raise UsageError(f"-o {out}: the model file must end in .npz")
     check_output_path(out)
+    source = gait_source(args)
     config = load_robot(args.robot, getattr(args, "calibration", None))
-    geometry = leg_geometry(config)
     options = FitOptions(samples=args.samples, basis=args.basis, n_basis=args.n_basis, roughness=args.roughness,
                          pose_variance=args.pose_variance, pose_tolerance_deg=args.pose_tolerance_deg,
                          motion_variance=args.variance, components=args.components, align=args.align,
                          label_degree=args.label_degree)
-    examples, rate = load_examples(args.examples, geometry, config.gait.rate_hz, config)
-    model = fit_model(examples, geometry, rate, options, periodic=args.basis == "fourier")
+    with progress("eigen fit: reading examples", total=len(args.examples), unit="file") as bar:
+        examples, rate = load_examples(args.examples, source.geometry, config.gait.rate_hz, source.robot, bar.update)
+    with progress("eigen fit: aligning cycles (DTW)", total=len(examples), unit="cycle") as bar:
+        model = fit_model(examples, source.geometry, rate, options, periodic=args.basis == "fourier", robot=config.name,
+                          on_progress=callback(bar))
     write_output(out, model.save)
     labels = sorted(set(np.round(model.labels, 6)))
     print(f"wrote {out}: {len(examples)} example cycles from {len(args.examples)} files, step lengths "
-          f"{', '.join(f'{v:g}' for v in labels)} m")
+          f"{', '.join(f'{v:g}' for v in labels)} m; for {config.name}, {describe_leg(source.geometry)}")
     print_pose_pca(model, options)
     print_variance_table("eigen-motion", model.variance_explained, model.n_components)
     cumulative = np.cumsum(model.variance_explained)
     print(f"{model.n_components} eigen-motions kept ({100 * cumulative[model.n_components - 1]:.2f}% of the variance)")
     return 0
+
+
+def describe_leg(g) -> str:
+    return f"leg {1000 * g.thigh:.0f} / {1000 * g.shank:.0f} / {1000 * g.foot:.0f} mm (thigh / shank / foot)"
 
 
 def print_variance_table(what: str, shares: np.ndarray, kept: int) -> None:
@@ -137,6 +148,29 @@ def _check_pose_limits(config, pose_deg: np.ndarray) -> None:
                                  f"({config.name})")
 
 
+def model_robot(args, model: EigenGaitModel, model_path: str):
+    """The robot to synthesise for: the model's own (``--robot`` may only name it again), with the leg the
+    model learnt; another robot or leg is refused in one line."""
+    if args.robot is None and model.robot:
+        try:
+            config = load_robot(model.robot, getattr(args, "calibration", None))
+        except UserError:
+            raise UsageError(f"{model_path} was fitted for {model.robot}, which is not a shipped robot: give its "
+                             f"config with --robot") from None
+    else:
+        config = load_robot(args.robot, getattr(args, "calibration", None))
+    if model.robot and config.name != model.robot:
+        raise UsageError(f"{model_path} was fitted for {model.robot}, not {config.name}: fit a model on "
+                         f"{config.name}'s walks (gaitbot eigen fit --robot {config.name})")
+    source = gait_source(argparse.Namespace(robot=str(config.path), calibration=getattr(args, "calibration", None),
+                                            thigh=args.thigh, shank=args.shank, foot=args.foot))
+    if source.geometry != model.geometry:
+        raise UsageError(f"{model_path} learnt a {describe_leg(model.geometry)}, this is a "
+                         f"{describe_leg(source.geometry)}: give the model's leg with --thigh/--shank/--foot, or "
+                         f"fit a model on walks of this leg")
+    return config, source
+
+
 def run_synth(args) -> int:
     out = Path(args.output)
     if out.suffix not in (".csv", ".npz"):
@@ -153,9 +187,7 @@ def run_synth(args) -> int:
         if value is not None and not (math.isfinite(value) and value >= 0):
             raise UsageError(f"--{name.replace('_', '-')} must be a finite number of metres, 0 or more, got {value:g}")
     model = EigenGaitModel.load(args.model)
-    config = load_robot(args.robot, getattr(args, "calibration", None))
-    if leg_geometry(config) != model.geometry:
-        raise UsageError(f"--robot {config.name}: its leg differs from the leg the model {args.model} was fitted with")
+    config, source = model_robot(args, model, args.model)
     settings = walk_settings(config)
     for name in ("step_length", "to_step_length"):
         value = getattr(args, name)
@@ -206,8 +238,12 @@ def run_synth(args) -> int:
                          f"({' '.join(str(exc).split())}); fit it again with `gaitbot eigen fit`") from None
     write_output(out, walk.save)
     xs = [h.x_m for h in walk.heel_strikes]
+    # the last heel strike is the walker's closing step: the trailing foot set down beside the leading one
+    # (a step of about 0, which the root rebuilt from contact can put a fraction of a millimetre behind)
+    steps = np.diff(xs)[:-1]
     print(f"wrote {out}: {len(walk)} frames, {walk.t_s[-1]:.2f} s, {len(xs)} heel strikes, "
-          f"{walk.root_m[-1, 0] - walk.root_m[0, 0]:.4f} m; step lengths {', '.join(f'{d:.4f}' for d in np.diff(xs))} m")
+          f"{walk.root_m[-1, 0] - walk.root_m[0, 0]:.4f} m; step lengths between heel strikes "
+          f"{', '.join(f'{d:.4f}' for d in steps)} m, then the trailing foot closes beside the leading one")
     if pose_report is not None:
         starts = [h.t_s for h in walk.heel_strikes if h.leg == "left"][:args.cycles]
         times = ", ".join(f"{t + pose_report[0]:.3f}" for t in starts)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gaitbot.app.options import UsageError, check_output_path, write_output
+from gaitbot.app.options import UsageError, check_output_path, walked_by, write_output
 from gaitbot.app.walks import trajectory_for_robot
 
 
@@ -13,8 +13,8 @@ def run(args) -> int:
     if out.suffix not in (".csv", ".npz"):
         raise UsageError(f"-o {out}: the output must end in .csv or .npz")
     check_output_path(out)
-    _, walker, trajectory = trajectory_for_robot(args)
+    source, walker, trajectory = trajectory_for_robot(args)
     write_output(out, trajectory.save)
-    print(f"wrote {out}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
+    print(f"wrote {out} for {walked_by(source)}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
           f"{len(walker.heel_strikes)} heel strikes, {trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.4f} m")
     return 0

@@ -40,6 +40,13 @@ def require_port(port: str) -> None:
         raise UsageError(f"--port {port}: not a serial port (not a terminal device) ({hint})")
 
 
+def refuse_port_in_dry_run(args) -> None:
+    """``--dry-run`` talks to the mock bus: a ``--port`` beside it would be silently ignored, so it is refused."""
+    if getattr(args, "dry_run", False) and getattr(args, "port", None):
+        raise UsageError(f"--port {args.port}: a dry run uses the mock bus, not a serial port; leave out --port "
+                         f"or --dry-run")
+
+
 def serial_port(config: RobotConfig, port: str | None, dry_run: bool) -> str:
     """``--port``, else the config's; outside a dry run it must exist."""
     port = port or config.bus.port

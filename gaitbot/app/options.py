@@ -142,6 +142,14 @@ MAX_SEED = 2**32 - 1
 MAX_REPLY_TIMEOUT_MS = 1000.0
 
 
+def walked_by(source: GaitSource) -> str:
+    """Whose leg a plan or a trajectory is for, said in every command's output (a default is never silent)."""
+    g = source.geometry
+    if source.robot is not None:
+        return source.robot.name
+    return f"a leg of {1000 * g.thigh:.0f} / {1000 * g.shank:.0f} / {1000 * g.foot:.0f} mm (thigh / shank / foot)"
+
+
 def parse_step_list(text: str) -> list[float]:
     """``0.3,0.4,...`` -> floats; one clear error for anything else."""
     if text is None or not text.strip():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 
+from gaitbot.app.options import walked_by
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.gait.walker import OnlineWalker
 from gaitbot.robot.walk_settings import GaitSource
@@ -23,9 +24,10 @@ def run(args) -> int:
         label = "close" if s["closing"] else str(s["index"])
         print(f"{label:>4} {s['leg']:>5} {s['length_m']:9.4f} {s['rv']:7.4f} {s['start_s']:8.3f} {s['end_s']:7.3f} "
               f"{s['foothold_m']:10.4f}")
-    print(f"{plan['n_steps']} steps, {plan['total_distance_m']:.4f} m in {plan['duration_s']:.2f} s "
+    print(f"{walked_by(source)}: {plan['n_steps']} steps, {plan['total_distance_m']:.4f} m in {plan['duration_s']:.2f} s "
           f"(cycle {plan['cycle_s']:.4f} s, {plan['rate_hz']:g} Hz, reachable step 0 to "
-          f"{plan['reachable_step_m'][1]:.4f} m, allowed up to {plan['max_step_m']:.4f} m)")
+          f"{plan['reachable_step_m'][1]:.4f} m, allowed up to {plan['max_step_m']:.4f} m). "
+          f"RV: walking speed over leg length, which sets Boulic's joint motion (docs/gait-model.md)")
     return 0
 
 
@@ -41,14 +43,18 @@ def _plan_terrain(args) -> int:
         label = "close" if s["closing"] else str(s["index"])
         print(f"{label:>4} {s['leg']:>5} {s['length_m']:9.4f} {s['start_s']:8.3f} {s['end_s']:7.3f} "
               f"{s['foothold_m']:10.4f} {s['height_m']:8.4f} {s['method']:>8} {s['lift_m']:7.4f}")
+    if plan["searches"]:
+        print("Pelvis low points between steps (mid double support, MDS), each chosen by seed 003's grid search "
+              "for the least joint acceleration (cost: weighted squared joint accelerations, (rad/s^2)^2 s):")
     for i, r in enumerate(plan["searches"], start=1):
-        centre = f"{r['centre_cost']:.4g}" if r["centre_cost"] is not None else "unreachable"
-        print(f"MDS {i}: pelvis at ({r['mds_m'][0]:.4f}, {r['mds_m'][1]:.4f}) m, cost {r['cost']:.4g} "
-              f"(middle of the region: {centre}); {r['evaluated']} cells scored, {r['pruned']} skipped as "
+        centre = f"{r['centre_cost']:.4g}" if r["centre_cost"] is not None else "out of the legs' reach"
+        print(f"{i:4d}: pelvis at ({r['mds_m'][0]:.4f}, {r['mds_m'][1]:.4f}) m, cost {r['cost']:.4g} "
+              f"(the middle of the region: {centre}); {r['evaluated']} cells scored, {r['pruned']} skipped as "
               f"unreachable, of {r['full_grid']} in a full search")
-    print(f"{plan['n_steps']} steps ({plan['n_terrain_steps']} on terrain), {plan['duration_s']:.2f} s, "
-          f"{plan['n_frames']} frames; grid search scored {plan['cells_evaluated']} cells against "
-          f"{plan['cells_full_search']} for full searches")
+    print(f"{walked_by(source)}: {plan['n_steps']} steps ({plan['n_terrain_steps']} by the terrain walker, the others by the flat "
+          f"walker), {plan['duration_s']:.2f} s, {plan['n_frames']} frames; the grid searches scored "
+          f"{plan['cells_evaluated']} cells against {plan['cells_full_search']} for full searches. lift: how high "
+          f"the swing foot is lifted above its path")
     return 0
 
 

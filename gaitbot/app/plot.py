@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gaitbot.app.options import UsageError, check_output_path, file_option, gait_source, write_output
+from gaitbot.app.options import UsageError, check_output_path, file_option, gait_source, walked_by, write_output
 from gaitbot.errors import UserError
 from gaitbot.gait.eigen import is_model_file
 from gaitbot.gait.terrain.course_file import load_course
@@ -48,5 +48,5 @@ def run(args) -> int:
         terrain = load_course(file_option(args.terrain, "--terrain")).terrain
     write_output(out, lambda path: plot_trajectory(trajectory, source.geometry, path, clearance=source.settings.clearance,
                                                    title=Path(args.file).name, terrain=terrain))
-    print(f"wrote {out}")
+    print(f"wrote {out} (the feet drawn for {walked_by(source)})")
     return 0

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gaitbot.app.hardware import serial_port
+from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
 from gaitbot.bus.factory import make_robot_bus
 from gaitbot.gait.footfall import ContactRoot
@@ -156,6 +156,7 @@ def _status_line(rate_hz: float):
 
 
 def run(args) -> int:
+    refuse_port_in_dry_run(args)
     config = load_robot(args.robot, getattr(args, "calibration", None))
     out = Path(args.output)
     _check_output(out)
@@ -192,7 +193,7 @@ def run(args) -> int:
         usable = "" if rows >= 2 else " (fewer than 2: not a readable trajectory)"
         print(f"wrote {out}: {rows} samples{usable}, {rows / rate_hz:.2f} s at {rate_hz:g} Hz; root from foot "
               f"contact, {sink.last_root_m[0]:.4f} m travelled")
-        print(result.timing.summary())
+        print(result.timing.summary(simulated_clock=args.dry_run))
     if health.summary():
         print(health.summary())
     mode = "dry run (mock bus, simulated clock)" if args.dry_run else f"{config.bus.backend} on {port}"

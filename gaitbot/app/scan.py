@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import math
 
-from gaitbot.app.hardware import serial_port
+from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
 from gaitbot.bus.bringup import ServoReport, describe_servo, survey
 from gaitbot.bus.factory import make_probe_bus
@@ -56,6 +56,7 @@ def _text(value, fmt: str = "{}") -> str:
 
 
 def run(args) -> int:
+    refuse_port_in_dry_run(args)
     config = load_robot(args.robot, getattr(args, "calibration", None))
     check_reply_timeout(args.reply_timeout_ms)
     backend, protocol = config.bus.backend, config.bus.protocol

@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import sys
 
-from gaitbot.app.hardware import serial_port, warn_about_latency
+from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
+from gaitbot.app.progress import callback, progress
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.log import BusRecorder, RecordingFailed
 from gaitbot.check.preflight import preflight
+from gaitbot.errors import UserError
 from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
 from gaitbot.robot.gains import gain_notes, gain_writes
 from gaitbot.robot.walk_settings import joint_limits_ticks
@@ -24,21 +26,27 @@ from gaitbot.stream.health import HealthMonitor
 from gaitbot.stream.session import walk_session
 
 
-def _status_line(total: int, strikes, rate_hz: float, health: HealthMonitor):
-    """A cheap live status line: frame, step, late frames and the latest servo health warning, rewritten in
-    place on a terminal."""
-    out = sys.stderr
-    if not out.isatty():
-        return None
+class LimitBroken(UserError):
+    """The walk breaks a limit of the robot (or would tip it over): refused before anything moves, in one line.
+    The check failed, as ``gaitbot check`` fails on the same file: exit 1 (docs/command-line.md), not 2 (the
+    input is readable)."""
+
+    exit_status = 1
+
+
+def _status(bar, strikes, rate_hz: float, health: HealthMonitor):
+    """The walk's live status on the bar: step, late frames and the latest servo health warning (the bar
+    itself counts frames)."""
     times = [h.t_s for h in strikes]
 
     def on_frame(k: int, stats) -> None:
         if k % 6:
             return
         step = sum(1 for t in times if t <= k / rate_hz)
-        warning = f"  warning: {health.status}" if health.status else ""
-        out.write(f"\rframe {k + 1}/{total}  step {step}/{len(times)}  late {stats.late_frames}{warning}   ")
-        out.flush()
+        warning = f"; warning: {health.status}" if health.status else ""
+        bar.update(k + 1 - bar.n)
+        bar.set_postfix_str(f"step {step}/{len(times)}, {stats.late_frames} late{warning}; Ctrl-C stops safely",
+                            refresh=False)
 
     return on_frame
 
@@ -51,6 +59,10 @@ def _warn_line(text: str) -> None:
 
 def run(args) -> int:
     check_sim_arguments(args)
+    refuse_port_in_dry_run(args)
+    if getattr(args, "demo", False):
+        print(f"note: no --steps, --distance, --terrain or --trajectory: walking the demo, --distance "
+              f"{args.distance:g}", file=sys.stderr)
     check_reply_timeout(args.reply_timeout_ms)
     config = load_robot(args.robot, getattr(args, "calibration", None))
     check_rate_option(config, args.rate)
@@ -58,7 +70,7 @@ def run(args) -> int:
     source, walker, trajectory = trajectory_for_robot(args)
     report = preflight(config, trajectory, on_boom=args.boom)
     if not report.ok:
-        raise UsageError(f"walk refused before anything moved: {report.first_error}")
+        raise LimitBroken(f"walk refused before anything moved: {report.first_error}")
     frames = trajectory_ticks(config, trajectory)
     straight = [name for name in config.walking_joint_names if name not in trajectory.joints]
     if straight:
@@ -97,22 +109,21 @@ def run(args) -> int:
     for note in gain_notes(config):
         print(f"note: {note}", file=sys.stderr)
     health = HealthMonitor.for_robot(config, _warn_line, clock.now)
+    what = "simulating" if sim is not None else "walking"
     try:
-        result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
-                              max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
-                              torque_off_on_exit=config.bus.torque_off_on_exit,
-                              on_frame=_status_line(len(frames), walker.heel_strikes, source.settings.rate_hz, health),
-                              setup_writes=gain_writes(config), health=health)
+        with progress(what, total=len(frames), unit="frame") as bar:
+            result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
+                                  max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
+                                  torque_off_on_exit=config.bus.torque_off_on_exit,
+                                  on_frame=_status(bar, walker.heel_strikes, source.settings.rate_hz, health),
+                                  setup_writes=gain_writes(config), health=health)
     finally:
         if recorder is not None:
             recorder.close()
     for note in getattr(bus, "open_notes", []):
         print(f"note: {note}", file=sys.stderr)
-    if sys.stderr.isatty():
-        sys.stderr.write("\n")
     if sim is not None and args.json:
-        sim.print_report(True, result.outcome)
-        return result.exit_code
+        return _sim_exit(_sim_report(sim, True, result.outcome, args.video), result.exit_code)
     if sim is not None:
         mode = (f"simulated robot (MuJoCo; {config.bus.backend} packets on a simulated bus, simulated clock; "
                 f"torso {'free to pitch' if args.free_pitch else 'on a boom, pitch held'})")
@@ -121,20 +132,30 @@ def run(args) -> int:
     elif args.realtime:
         mode = "dry run (mock bus, paced in real time)"
     else:
-        mode = "dry run (mock bus, simulated clock: timing figures are exact by construction; --realtime paces it)"
+        mode = "dry run (mock bus, simulated clock; --realtime paces it)"
     if config.calibration_file is not None:
         print(f"note: calibration {config.calibration_file} applied", file=sys.stderr)
     print(f"{config.name}: {mode}: {len(walker.planned_steps)} heel strikes, "
           f"{trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.3f} m planned. {result.message()}")
     if result.walk_stats is not None:
-        print(result.walk_stats.summary())
+        print(result.walk_stats.summary(simulated_clock=isinstance(clock, VirtualClock)))
     if health.summary():
         print(health.summary())
     if args.record:
         print(f"recording: {args.record}")
     if sim is not None:
-        sim.print_report(False, result.outcome)
+        return _sim_exit(_sim_report(sim, False, result.outcome, args.video), result.exit_code)
     return result.exit_code
+
+
+def _sim_report(sim, as_json: bool, outcome: str, video: str | None):
+    with progress(f"writing {video}" if video else "measuring", unit="frame") as bar:
+        return sim.print_report(as_json, outcome, callback(bar))
+
+
+def _sim_exit(report, session_exit: int) -> int:
+    """A simulated robot that fell failed its walk: exit 1 (docs/command-line.md), whatever the session says."""
+    return 1 if report.fell and session_exit == 0 else session_exit
 
 
 def check_sim_arguments(args) -> None:

@@ -4,10 +4,13 @@ plan and a trajectory, for ``plan``, ``generate`` and ``walk``."""
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
 from gaitbot.app.options import UsageError, check_rate_option, file_option, gait_source, step_lengths
+from gaitbot.app.progress import callback, progress
+from gaitbot.gait.footfall import detect_heel_strikes
 from gaitbot.gait.segments import GaitGenerationError
 from gaitbot.gait.step_length import StepLengthError
 from gaitbot.gait.terrain.course_file import load_course
@@ -39,7 +42,8 @@ def leg_origin(args, source: GaitSource) -> str:
 
 @dataclass(frozen=True)
 class FileWalk:
-    """A trajectory file walked as it is (``walk --trajectory``): its heel strikes stand for the plan."""
+    """A trajectory file walked as it is (``walk --trajectory``): its heel strikes (the file's, or found from
+    the feet) stand for the plan."""
 
     heel_strikes: tuple
 
@@ -70,8 +74,9 @@ def trajectory_file_walk(args) -> tuple[GaitSource, FileWalk, Trajectory]:
     if source.robot is not None:
         check_rate_option(source.robot, rate, f"--trajectory {args.trajectory}: its {rate:.4g} Hz")
     settings = WalkSettings(source.settings.cycle_s, rate, source.settings.clearance)
-    return GaitSource(source.geometry, settings, source.max_step_m, source.robot), \
-        FileWalk(tuple(trajectory.heel_strikes)), trajectory
+    # a CSV carries no heel strikes: find them from the feet, as plot and eigen fit do (footfall.py)
+    strikes = tuple(trajectory.heel_strikes) or tuple(detect_heel_strikes(trajectory, source.geometry))
+    return GaitSource(source.geometry, settings, source.max_step_m, source.robot), FileWalk(strikes), trajectory
 
 
 def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:
@@ -99,8 +104,9 @@ def build_terrain_walk(args):
     course = load_course(file_option(args.terrain, "--terrain"))
     settings = terrain_settings(source, course, getattr(args, "clearance", None))
     try:
-        walk = plan_terrain_walk(make_context(source.geometry, source.settings), course.terrain, course.start_m,
-                                 course.end_m, settings, source.max_step_m)
+        with progress(f"planning {Path(course.path).name}", unit="step") as bar:
+            walk = plan_terrain_walk(make_context(source.geometry, source.settings), course.terrain, course.start_m,
+                                     course.end_m, settings, source.max_step_m, on_progress=callback(bar))
     except CourseError as exc:
         raise UsageError(f"{course.path}: {exc}") from None
     except GaitGenerationError as exc:

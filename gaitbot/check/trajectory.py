@@ -155,6 +155,7 @@ class CheckReport:
     velocity_method: str = VELOCITY_METHOD
     acceleration_method: str = ACCELERATION_METHOD
     balance: "BalanceSummary | None" = None
+    robot: str = ""  # the robot's name (people read it; the config's path may be deep in site-packages)
 
     @property
     def errors(self) -> tuple[Violation, ...]:
@@ -181,6 +182,7 @@ class CheckReport:
         """Plain data for JSON."""
         return {
             "ok": self.ok,
+            "robot": self.robot,
             "config": self.config_path,
             "n_frames": self.n_frames,
             "duration_s": self.duration_s,
@@ -195,7 +197,7 @@ class CheckReport:
 
     def format_text(self, max_per_kind: int = 5) -> str:
         """A short table per joint, then the first ``max_per_kind`` violations of each kind and a count of the rest."""
-        lines = [f"{self.config_path}: {self.n_frames} frames over {self.duration_s:.3f} s, "
+        lines = [f"{self.robot or self.config_path}: {self.n_frames} frames over {self.duration_s:.3f} s, "
                  f"margin {self.margin_deg:g} deg: {'OK' if self.ok else 'FAIL'}"
                  f" ({len(self.errors)} errors, {len(self.warnings)} warnings)",
                  "",
@@ -279,7 +281,7 @@ def check_trajectory(config: RobotConfig, t_s, angles_deg, margin_deg: float = 0
                  [v for v in found if v.joint == joint.name], lo[c], hi[c], v_lim[c], a_lim[c])
         for c, joint in enumerate(joints))
     return CheckReport(config_path=str(config.path), n_frames=len(t), duration_s=float(t[-1] - t[0]),
-                       margin_deg=float(margin_deg), joints=summaries, violations=tuple(found))
+                       margin_deg=float(margin_deg), joints=summaries, violations=tuple(found), robot=config.name)
 
 
 def _joint_violations(joint: JointConfig, t, angle_deg, ticks, t_vel, vel, t_acc, acc, margin_deg) -> list[Violation]:

@@ -1,8 +1,11 @@
 """``gaitbot plot``: a trajectory as one picture a person can read at a glance.
 
-Three panels sharing the time axis where it makes sense: joint angles against time (heel strikes
-marked), foot heights against time (lowest sole point of each foot, with the clearance line), and
-a stick-figure strip of the walk in the world with the footholds marked.
+Three panels. Joint angles against time, heel strikes marked by lines a reader can see, the legend
+outside the plot so it hides no curve. Foot clearance against time: each foot's distance from its sole
+to the nearest ground, treads and risers alike, so the trace is continuous where a foot passes over a
+kerb's edge (a height above "the ground under the foot" jumps there, as that ground does), with the
+configured clearance as a line. Stick figures of the walk in the world, a few poses only (at heel
+strikes, at most MAX_POSES), the far leg paler, over the ground or the terrain and the footholds.
 """
 
 from __future__ import annotations
@@ -17,6 +20,8 @@ from gaitbot.gait.joints import PITCH_JOINTS
 from gaitbot.gait.trajectory import HeelStrike, Trajectory
 
 _COLOURS = {"left": "tab:blue", "right": "tab:red"}
+MAX_POSES = 16  # stick figures drawn at most (evenly chosen among the heel strikes)
+GROUND = "saddlebrown"
 
 
 def _world_points(geometry: LegGeometry, trajectory: Trajectory, side: int):
@@ -26,8 +31,40 @@ def _world_points(geometry: LegGeometry, trajectory: Trajectory, side: int):
     return root, knee + root, ankle + root, heel + root, toe + root
 
 
-def _foot_heights(geometry: LegGeometry, trajectory: Trajectory, terrain=None) -> dict[str, np.ndarray]:
-    """Lowest sole point of each foot above the ground (or the terrain under it), metres."""
+def ground_profile(terrain, x_lo: float, x_hi: float) -> np.ndarray:
+    """The ground as a polyline (k, 2) from x_lo to x_hi: treads and the risers between them (flat: y = 0)."""
+    if terrain is None:
+        return np.array([[x_lo, 0.0], [x_hi, 0.0]])
+    points = []
+    for surface in terrain.surfaces:
+        a, b = max(surface.start, x_lo), min(surface.end, x_hi)
+        if a < b:
+            points += [[a, surface.height], [b, surface.height]]
+    return np.array(points)
+
+
+def _point_segment_distance(p, a, b):
+    """Distance from points p (n, 2) to segments a-b (n, 2)."""
+    ab = b - a
+    length2 = np.maximum((ab * ab).sum(axis=-1), 1e-300)
+    u = np.clip(((p - a) * ab).sum(axis=-1) / length2, 0.0, 1.0)
+    return np.hypot(*(p - a - u[..., None] * ab).T)
+
+
+def sole_clearance(heel, toe, profile: np.ndarray) -> np.ndarray:
+    """Per frame, the distance from the sole (segment heel-toe) to the ground polyline; 0 where they touch."""
+    n = len(heel)
+    best = np.full(n, np.inf)
+    for a, b in zip(profile[:-1], profile[1:]):
+        a_, b_ = np.broadcast_to(a, (n, 2)), np.broadcast_to(b, (n, 2))
+        d = np.minimum.reduce([_point_segment_distance(heel, a_, b_), _point_segment_distance(toe, a_, b_),
+                               _point_segment_distance(a_, heel, toe), _point_segment_distance(b_, heel, toe)])
+        best = np.minimum(best, d)
+    return best
+
+
+def _foot_lows(geometry: LegGeometry, trajectory: Trajectory, terrain=None) -> dict[str, np.ndarray]:
+    """Lowest sole point of each foot above the ground under it, metres (heel strikes are read from these)."""
     lows = {}
     for side, name in ((0, "left"), (1, "right")):
         _, _, _, heel, toe = _world_points(geometry, trajectory, side)
@@ -46,77 +83,91 @@ def _detected_heel_strikes(geometry: LegGeometry, trajectory: Trajectory, lows) 
     return tuple(heel_strikes_from_heights(trajectory.t_s, heights, heel_x, CONTACT_TOL_FRACTION * geometry.leg_length))
 
 
+def _mark_strikes(ax, heel_strikes, label: bool) -> None:
+    for i, strike in enumerate(heel_strikes):
+        ax.axvline(strike.t_s, color=_COLOURS[strike.leg], lw=1.0, ls="--", alpha=0.75, zorder=0,
+                   label=f"{strike.leg} heel strike" if label and strike.leg not in
+                   {h.leg for h in heel_strikes[:i]} else None)
+
+
 def plot_trajectory(trajectory: Trajectory, geometry: LegGeometry, out: Path, clearance: float = 0.0,
                     title: str = "", terrain=None) -> None:
-    """``terrain`` (a gaitbot.gait.terrain.model.Terrain), when given, is drawn under the walk; foot heights
-    are then measured from the terrain under each foot and footholds sit on their treads."""
+    """``terrain`` (a gaitbot.gait.terrain.model.Terrain), when given, is drawn under the walk; clearances
+    are then measured to the terrain and footholds sit on their treads."""
+    import matplotlib.pyplot as plt
+
+    fig = trajectory_figure(trajectory, geometry, clearance, title, terrain)
+    fig.savefig(out, dpi=100)
+    plt.close(fig)
+
+
+def trajectory_figure(trajectory: Trajectory, geometry: LegGeometry, clearance: float = 0.0, title: str = "",
+                      terrain=None):
+    """The picture of ``plot_trajectory`` as a matplotlib figure (the caller closes it)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     t = trajectory.t_s
-    lows = _foot_heights(geometry, trajectory, terrain)
-    heel_strikes = trajectory.heel_strikes or _detected_heel_strikes(geometry, trajectory, lows)
-    fig = plt.figure(figsize=(12, 9), constrained_layout=True)
-    grid = fig.add_gridspec(3, 1, height_ratios=[1.2, 0.8, 1.0])
+    heel_strikes = trajectory.heel_strikes or _detected_heel_strikes(geometry, trajectory,
+                                                                     _foot_lows(geometry, trajectory, terrain))
+    fig = plt.figure(figsize=(13, 10), constrained_layout=True)
+    grid = fig.add_gridspec(3, 1, height_ratios=[1.2, 0.8, 1.1])
     ax_angles, ax_feet, ax_stick = (fig.add_subplot(grid[i]) for i in range(3))
+    ax_feet.sharex(ax_angles)
 
     for i, name in enumerate(trajectory.joints):
         side = "left" if name.endswith("left") else "right"
         style = {"hip": "-", "knee": "--", "ankle": ":"}[name.split("_")[0]]
         if "_pitch" not in name:
             style = "-."  # roll and yaw
-        ax_angles.plot(t, np.degrees(trajectory.angles_rad[:, i]), style, color=_COLOURS[side], lw=1.2,
-                       label=name.replace("_pitch", ""))
-    for strike in heel_strikes:
-        ax_angles.axvline(strike.t_s, color=_COLOURS[strike.leg], lw=0.5, alpha=0.4)
+        ax_angles.plot(t, np.degrees(trajectory.angles_rad[:, i]), style, color=_COLOURS[side], lw=1.3,
+                       label=name.replace("_pitch", "").replace("_", " "))
+    _mark_strikes(ax_angles, heel_strikes, label=True)
     ax_angles.set_ylabel("joint angle (deg, flexion +)")
-    ax_angles.legend(ncol=6, fontsize=8, loc="upper center")
-    ax_angles.set_title(f"{title}  {len(t)} frames, {t[-1]:.2f} s, {trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.3f} m"
-                        f"  (vertical lines: heel strikes)")
+    ax_angles.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
+    ax_angles.set_title(f"{title}  {len(t)} frames, {t[-1]:.2f} s, "
+                        f"{trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.3f} m")
     ax_angles.grid(alpha=0.3)
 
-    for name, low in lows.items():
-        above = " above the terrain" if terrain is not None else ""
-        ax_feet.plot(t, 1000 * low, color=_COLOURS[name], label=f"{name} foot lowest point{above}")
+    xs = np.concatenate([_world_points(geometry, trajectory, side)[k][:, 0] for side in (0, 1) for k in (3, 4)])
+    profile = ground_profile(terrain, float(xs.min()) - 0.1, float(xs.max()) + 0.1)
+    for side, name in ((0, "left"), (1, "right")):
+        _, _, _, heel, toe = _world_points(geometry, trajectory, side)
+        ax_feet.plot(t, 1000 * sole_clearance(heel, toe, profile), color=_COLOURS[name], lw=1.3, label=f"{name} foot")
     if clearance > 0:
-        ax_feet.axhline(1000 * clearance, color="k", ls="--", lw=0.8, label=f"clearance {1000 * clearance:.0f} mm")
-    ax_feet.set_ylabel("foot height (mm)")
+        ax_feet.axhline(1000 * clearance, color="k", ls=":", lw=1.0, label=f"clearance {1000 * clearance:.0f} mm")
+    _mark_strikes(ax_feet, heel_strikes, label=False)
+    ax_feet.set_ylabel("sole to ground (mm)" if terrain is None else "sole to terrain (mm)\ntreads and risers")
     ax_feet.set_xlabel("time (s)")
-    ax_feet.legend(fontsize=8, loc="upper right")
+    ax_feet.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
     ax_feet.grid(alpha=0.3)
 
     strikes = [int(round(h.t_s / (t[1] - t[0]))) for h in heel_strikes]
-    marks = [0, *strikes, len(t) - 1]
-    frames = sorted({*marks, *((a + b) // 2 for a, b in zip(marks, marks[1:]))})
-    for side, name in ((0, "left"), (1, "right")):
+    marks = sorted({0, *strikes, len(t) - 1})
+    frames = [marks[int(round(i))] for i in np.linspace(0, len(marks) - 1, min(MAX_POSES, len(marks)))]
+    for side, name, alpha in ((1, "right", 0.95), (0, "left", 0.45)):  # the far (left) leg paler, drawn behind
         root, knee, ankle, heel, toe = _world_points(geometry, trajectory, side)
         for k in frames:
-            xs = [root[k, 0], knee[k, 0], ankle[k, 0], heel[k, 0], toe[k, 0], ankle[k, 0]]
-            ys = [root[k, 1], knee[k, 1], ankle[k, 1], heel[k, 1], toe[k, 1], ankle[k, 1]]
-            ax_stick.plot(xs, ys, color=_COLOURS[name], lw=1.0, alpha=0.7)
+            xs_ = [root[k, 0], knee[k, 0], ankle[k, 0], heel[k, 0], toe[k, 0], ankle[k, 0]]
+            ys_ = [root[k, 1], knee[k, 1], ankle[k, 1], heel[k, 1], toe[k, 1], ankle[k, 1]]
+            ax_stick.plot(xs_, ys_, color=_COLOURS[name], lw=1.4, alpha=alpha, solid_joinstyle="round")
     ax_stick.plot(trajectory.root_m[:, 0], trajectory.root_m[:, 2], color="k", lw=0.8, label="hip path")
+    bottom = float(profile[:, 1].min()) - 0.02
+    ax_stick.fill_between(profile[:, 0], profile[:, 1], bottom, color=GROUND, alpha=0.25, lw=0)
+    ax_stick.plot(profile[:, 0], profile[:, 1], color=GROUND, lw=1.5, label="ground" if terrain is None else "terrain")
     ground = (lambda x: float(terrain.height_at(x))) if terrain is not None else (lambda x: 0.0)  # noqa: E731
-    for strike in heel_strikes:
-        ax_stick.plot([strike.x_m], [ground(strike.x_m)], marker="^", color=_COLOURS[strike.leg], ms=8)
-    if terrain is None:
-        ax_stick.axhline(0.0, color="saddlebrown", lw=1.5)
-    else:
-        x0, x1 = ax_stick.get_xlim()
-        px, py = [], []
-        for surface in terrain.surfaces:
-            a, b = max(surface.start, x0), min(surface.end, x1)
-            if a < b:
-                px += [a, b]
-                py += [surface.height, surface.height]
-        ax_stick.plot(px, py, color="saddlebrown", lw=1.5, label="terrain")
+    for leg in ("left", "right"):
+        xs_ = [h.x_m for h in heel_strikes if h.leg == leg]
+        ax_stick.plot(xs_, [ground(x) for x in xs_], ls="none", marker="^", color=_COLOURS[leg], ms=8,
+                      label=f"{leg} foothold")
+    ax_stick.set_ylim(bottom, None)
     ax_stick.set_aspect("equal")
-    ax_stick.set_xlabel("x (m)   poses at each heel strike and mid-step; triangles: planned footholds (blue left, red right)")
+    ax_stick.set_xlabel(f"x (m): poses at {len(frames)} heel strikes (right leg dark, left pale)")
     ax_stick.set_ylabel("y (m)")
-    ax_stick.legend(fontsize=8, loc="upper left")
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
+    ax_stick.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
+    return fig
 
 
 def plot_eigen_model(model_path, out: Path, n_show: int = 3) -> None:
@@ -152,10 +203,16 @@ def plot_eigen_model(model_path, out: Path, n_show: int = 3) -> None:
                 ax.set_ylabel(f"eigen-motion {i + 1}{kept}\n{100 * share[i]:.1f}% of variance")
             if i == k - 1:
                 ax.set_xlabel("aligned cycle phase (%), 0 = left heel strike")
-            if i == 0 and j == 2:
-                ax.legend(fontsize=7, loc="best")
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], color="tab:blue", lw=1.5, label="left leg"),
+               Line2D([], [], color="tab:red", lw=1.5, label="right leg"),
+               Line2D([], [], color="k", lw=1.5, label="mean cycle"),
+               Line2D([], [], color="k", lw=1.0, ls="--", label="mean + 2 sd x eigen-motion"),
+               Line2D([], [], color="k", lw=1.0, ls=":", label="mean - 2 sd x eigen-motion")]
+    fig.legend(handles=handles, loc="outside lower center", ncol=5, fontsize=9)
     labels = ", ".join(f"{v:g}" for v in sorted(set(np.round(model.labels, 4))))
-    fig.suptitle(f"{Path(str(model_path)).name}: mean cycle (solid), mean + 2 sd x eigen-motion (dashed), "
-                 f"mean - 2 sd (dotted); {len(model.labels)} cycles, step lengths {labels} m", fontsize=9)
+    fig.suptitle(f"{Path(str(model_path)).name}: the eigen-motions of {len(model.labels)} example cycles, step "
+                 f"lengths {labels} m", fontsize=10)
     fig.savefig(out, dpi=100)
     plt.close(fig)

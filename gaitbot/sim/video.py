@@ -82,24 +82,31 @@ class VideoRecorder:
                                 np.array([x, self._marker_y[leg], 0.0005]), np.eye(3).ravel(), np.array(MARKER_RGBA[leg], dtype=np.float32))
             scene.ngeom += 1
 
-    def save(self) -> int:
-        """Write the file; return the number of frames."""
+    def save(self, on_progress=None) -> int:
+        """Write the file; return the number of frames. ``on_progress(k, n)`` is told as frames are encoded."""
         if not self.frames:
             raise VideoError(f"--video {self.path}: nothing was rendered (the walk never started)")
+        report = on_progress or (lambda k, n: None)
+        n = len(self.frames)
         if self.path.suffix.lower() == ".gif":
             from PIL import Image
 
-            images = [Image.fromarray(f) for f in self.frames]
-            images[0].save(self.path, save_all=True, append_images=images[1:], duration=round(1000 / self.fps),
-                           loop=0, optimize=False)
+            def rest():  # Pillow encodes the frames as it takes them from here
+                for k, frame in enumerate(self.frames[1:], start=2):
+                    yield Image.fromarray(frame)
+                    report(k, n)
+
+            Image.fromarray(self.frames[0]).save(self.path, save_all=True, append_images=rest(),
+                                                 duration=round(1000 / self.fps), loop=0, optimize=False)
         else:
             import imageio_ffmpeg
 
             writer = imageio_ffmpeg.write_frames(str(self.path), (self.width, self.height), fps=self.fps,
                                                  codec="libx264", pix_fmt_out="yuv420p", quality=7)
             writer.send(None)
-            for frame in self.frames:
+            for k, frame in enumerate(self.frames, start=1):
                 writer.send(np.ascontiguousarray(frame))
+                report(k, n)
             writer.close()
         self.renderer.close()
         return len(self.frames)

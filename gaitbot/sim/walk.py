@@ -72,10 +72,11 @@ class SimWalk:
     def report(self) -> SimReport:
         return self.meter.report(self.plan, self.robot.free_pitch)
 
-    def print_report(self, as_json: bool, outcome: str) -> None:
-        """The measurements: a summary paragraph, or (``as_json``) one JSON object on stdout."""
+    def print_report(self, as_json: bool, outcome: str, on_progress=None) -> SimReport:
+        """The measurements: a summary paragraph, or (``as_json``) one JSON object on stdout; returned too.
+        ``on_progress(k, n)`` follows the video's encoding, if there is one."""
         report = self.report()
-        frames = self.video.save() if self.video is not None else 0
+        frames = self.video.save(on_progress) if self.video is not None else 0
         if as_json:
             print(json.dumps({"robot": self.config.name, "outcome": outcome, **report.to_dict(),
                               "video": str(self.video.path) if self.video is not None else None}, indent=2))
@@ -83,3 +84,4 @@ class SimWalk:
             print(report.summary())
         if self.video is not None:
             print(f"video: {self.video.path} ({frames} frames)", file=sys.stderr if as_json else sys.stdout)
+        return report

@@ -25,7 +25,7 @@ from gaitbot.gait import (TABLE1_LEG, LegGeometry, WalkSettings, generate_walk, 
 from gaitbot.gait.walker import plan_walk, trajectory_of
 from gaitbot.robot.config import load_robot_config
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings
-from helpers import CONFIG_DIR as REPO_CONFIG_DIR
+from helpers import CONFIG_DIR as REPO_CONFIG_DIR, swing_clearances
 
 CONFIG_DIR = str(REPO_CONFIG_DIR)
 CONFIG_FILES = sorted(glob.glob(os.path.join(CONFIG_DIR, "*.toml")))
@@ -277,6 +277,20 @@ def test_swing_clearance(name):
     w = walk_for(name)
     failures = swing_clearance_failures(w)
     assert not failures, "; ".join(failures)
+
+
+@pytest.mark.parametrize("name", ROBOT_CASES)
+def test_swing_keeps_the_clearance_while_the_foot_moves_forward(name):
+    """docs/gait.md's rule, the one terrain walks answer to too (tests/helpers.py ``swing_clearances``, own FK):
+    the whole sole at least the configured clearance above the ground while the ankle covers 10% to 90% of
+    its travel, and off the ground within 5% of the swing's time."""
+    cfg = load_robot_config(os.path.join(CONFIG_DIR, name.rsplit("-", 1)[0] + ".toml"))
+    w = walk_for(name)
+    found = swing_clearances(cfg, w.traj)
+    assert len(found) >= 4
+    for travel, least, lift_off in found:
+        assert least >= cfg.gait.clearance_m * (1 - 1e-3), f"a swing of {travel:.3f} m lifts only {least * 1000:.1f} mm"
+        assert lift_off <= 0.05
 
 
 @pytest.mark.parametrize("name", list(ALL_CASES))

@@ -59,12 +59,31 @@ def test_mistakes_name_file_and_field(tmp_path, body, field, words):
 def test_course_fields_checked(tmp_path):
     with pytest.raises(TerrainFileError, match=r"course.end_m: .*beyond start_m"):
         load_course(write(tmp_path, "[course]\nstart_m = 1.0\nend_m = 0.5\n"))
-    with pytest.raises(TerrainFileError, match=r"course: missing"):
-        load_course(write(tmp_path, "[[tread]]\nstart_m = 1.0\nlength_m = 0.5\nheight_m = 0.0\n"))
     with pytest.raises(TerrainFileError, match=r"file: not valid TOML"):
         load_course(write(tmp_path, "[course\n"))
     with pytest.raises(TerrainFileError, match=r"file: no such file"):
         load_course(tmp_path / "missing.toml")
+
+
+def test_course_table_is_optional_and_its_extent_follows_from_the_treads(tmp_path):
+    """Without [course]: start at 0, end 0.3 m past the far end of the last tread (END_PAST_TREADS_M), margin 0.01."""
+    treads = "[[tread]]\nstart_m = 0.4\nlength_m = 0.5\nheight_m = 0.03\n[[tread]]\nstart_m = 0.9\nlength_m = 0.2\n" \
+             "height_m = 0.0\n"
+    course = load_course(write(tmp_path, treads))
+    assert (course.start_m, course.end_m, course.margin_m) == (0.0, pytest.approx(1.4), 0.01)
+    course = load_course(write(tmp_path, "[course]\nend_m = 0.8\n" + treads))
+    assert (course.start_m, course.end_m) == (0.0, 0.8)
+    course = load_course(write(tmp_path, "[course]\nstart_m = 0.1\n" + treads))
+    assert (course.start_m, course.end_m) == (0.1, pytest.approx(1.4))
+
+
+def test_a_course_without_course_table_walks(tmp_path, capsys):
+    from helpers import run_cli
+
+    path = write(tmp_path, "[[tread]]\nstart_m = 0.4\nlength_m = 0.6\nheight_m = 0.02\n")
+    code, out, err = run_cli(capsys, "plan", "--terrain", path, "--json")
+    assert code == 0, err
+    assert '"n_terrain_steps"' in out
 
 
 def test_profile_heights_and_edges():

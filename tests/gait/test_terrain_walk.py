@@ -20,13 +20,14 @@ from gaitbot.robot.config import load_robot_config
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 from gaitbot.robot.walk_settings import GaitSource, terrain_settings
 from gaitbot.gait.terrain.course_file import Course, load_course
-from helpers import REPO_ROOT, height, surface_pieces
+from helpers import REPO_ROOT, fk_foot, height, surface_pieces, swing_clearances
 
 ROOT = REPO_ROOT
 EXAMPLES = ROOT / "config" / "terrain"
 ROBOTS = sorted(p.stem for p in (ROOT / "config").glob("*.toml"))
 TOUCH = 1e-9  # a point this close to the terrain in two consecutive frames is a locked contact
 MARGIN = 0.01
+LIFT_OFF_SHARE = 0.05  # the most of a swing's time its sole may stay within 0.2 mm of the ground at lift-off
 
 
 class Robot:
@@ -56,17 +57,7 @@ def robot(name: str) -> Robot:
 
 
 def fk_feet(cfg, q, root):
-    """Heel and toe in the world of one leg from hip, knee, ankle flexion (own FK, section 1; the heel is
-    heel_back_m behind the ankle's projection on the sole)."""
-    g = cfg.geometry
-    h, k, a = q[:, 0], q[:, 1], q[:, 2]
-    ankle = root + np.column_stack([g.thigh_m * np.sin(h) + g.shank_m * np.sin(h - k),
-                                    -g.thigh_m * np.cos(h) - g.shank_m * np.cos(h - k)])
-    p = h - k + a  # sole pitch, toe up
-    along_sole = np.column_stack([np.cos(p), np.sin(p)])
-    heel = ankle + g.ankle_height_m * np.column_stack([np.sin(p), -np.cos(p)]) - g.heel_back_m * along_sole
-    toe = heel + g.foot_m * along_sole
-    return heel, toe
+    return fk_foot(cfg, q, root)[1:]
 
 
 def judge(rb: Robot, walk, settings, treads):
@@ -97,6 +88,10 @@ def judge(rb: Robot, walk, settings, treads):
         on = [p for p in pieces if p[0] + settings.margin - 1e-9 <= strike.x_m
               and strike.x_m + cfg.geometry.foot_m + settings.margin <= p[1] + 1e-9]
         assert on, f"foothold at {strike.x_m} not on one tread with its margin"
+    # every swing keeps the clearance while its foot moves forward, and leaves the ground at once (docs/gait.md)
+    for travel, least, lift_off in swing_clearances(cfg, traj, treads):
+        assert least >= settings.clearance * (1 - 1e-3), f"a swing of {travel:.3f} m lifts only {least * 1000:.1f} mm"
+        assert lift_off <= LIFT_OFF_SHARE, f"a swing of {travel:.3f} m stays on the ground for {lift_off:.0%} of it"
     # continuous joint velocities: at every switch of segment the velocity changes no more than nearby
     vel = np.diff(traj.angles_rad, axis=0) * walk.ctx.rate_hz
     jump = np.abs(np.diff(vel, axis=0)).max(axis=1)

@@ -29,9 +29,9 @@ KEYS = ("distance_planned_m", "distance_travelled_m", "fell", "fell_at_s", "max_
         "max_torque_fraction", "max_tracking_error_deg")
 
 
-def sim_json(capsys, *args: str) -> dict:
+def sim_json(capsys, *args: str, status: int = 0) -> dict:
     capsys.readouterr()
-    assert main(["walk", "--sim", "--json", *args]) == 0
+    assert main(["walk", "--sim", "--json", *args]) == status
     return json.loads(capsys.readouterr().out)  # the whole of stdout is one JSON object
 
 
@@ -87,8 +87,8 @@ def test_a_toe_dragging_walk_is_caught_by_the_scuff_fraction(name, capsys, tmp_p
     assert dragging["distance_travelled_m"] < 0.5 * clean["distance_travelled_m"]
 
 
-def test_free_pitch_is_reported_as_a_fall_with_its_time(capsys):
-    r = sim_json(capsys, "--free-pitch", "--distance", "0.3")
+def test_free_pitch_is_reported_as_a_fall_with_its_time_and_exit_1(capsys):
+    r = sim_json(capsys, "--free-pitch", "--distance", "0.3", status=1)  # the robot failed: exit 1
     assert r["free_pitch"] is True
     assert r["fell"] is True
     assert 0.0 < r["fell_at_s"] < r["simulated_s"]

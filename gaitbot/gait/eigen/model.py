@@ -119,6 +119,7 @@ class EigenGaitModel:
     sources: tuple = field(default_factory=tuple)
     pose_variance_dims: int = 0  # pose axes the variance rule alone would keep (0: not recorded)
     pose_residuals_deg: np.ndarray | None = None  # (6,) largest joint error of the examples with 1..6 pose axes
+    robot: str = ""  # the robot the examples were walked for (its config's name); "" in files that predate it
 
     # -- basic evaluation -------------------------------------------------------------------
     @property
@@ -209,7 +210,7 @@ class EigenGaitModel:
                  right_strike_phases=self.right_strike_phases, label_degree=self.label_degree,
                  geometry=np.array([g.thigh, g.shank, g.foot, g.hip_width, g.ankle_height, g.heel_back]),
                  rate_hz=self.rate_hz, sources=np.array([str(s) for s in self.sources], dtype=str),
-                 pose_variance_dims=self.pose_variance_dims,
+                 pose_variance_dims=self.pose_variance_dims, robot=np.array(self.robot),
                  pose_residuals_deg=np.full(0, np.nan) if self.pose_residuals_deg is None else self.pose_residuals_deg)
 
     @classmethod
@@ -313,7 +314,7 @@ class EigenGaitModel:
                    whole("n_components", 1, m), scores, labels, shaped("warp_coefs", (n, n_basis)),
                    durations, phases, whole("label_degree", 0, 10),
                    LegGeometry(*map(float, geometry)), rate_hz, tuple(str(x) for x in sources),
-                   variance_dims, residuals)
+                   variance_dims, residuals, text("robot") if "robot" in d else "")
 
 
 #: Sizes a model file may claim (a fitted model is far inside them): samples per cycle, basis functions,
@@ -334,8 +335,12 @@ def is_model_file(path: str | Path) -> bool:
 
 
 def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: float,
-              options: FitOptions = FitOptions(), periodic: bool = True) -> EigenGaitModel:
-    """Seed 004 sections 3 and 4 on example cycles (see the module docstring)."""
+              options: FitOptions = FitOptions(), periodic: bool = True, robot: str = "",
+              on_progress=None) -> EigenGaitModel:
+    """Seed 004 sections 3 and 4 on example cycles (see the module docstring). ``geometry`` is the leg that
+    walked the examples and ``robot`` the robot they are for: the model keeps both, and synthesis for
+    another leg or robot is refused (app/eigen.py). ``on_progress(k, n)``, if given, is told as each of the n
+    example cycles is aligned (the time-consuming part: dynamic time warping)."""
     n = len(examples)
     if n < 2:
         raise EigenModelError(f"functional PCA needs at least 2 example cycles, got {n}")
@@ -351,13 +356,15 @@ def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: floa
     cycles = [resample_cycle(e.angles_rad, options.samples, periodic) for e in examples]
     reference = cycles[int(np.argsort(labels)[n // 2])]
     aligned, warps = [], []
-    for c in cycles:
+    for k, c in enumerate(cycles, start=1):
         if options.align == "dtw":
             a, h = align_to_reference(reference, c, options.dtw_band, periodic)
         else:
             a, h = c, phases.copy()
         aligned.append(a)
         warps.append(h)
+        if on_progress is not None:
+            on_progress(k, n)
     aligned = np.array(aligned)  # (N, S, 6)
 
     # pose PCA (eq. 1; pose.py)
@@ -397,4 +404,4 @@ def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: floa
                           np.array([e.duration_s for e in examples]),
                           np.array([e.right_strike_phase for e in examples]), options.label_degree, geometry,
                           float(rate_hz), tuple(sorted({e.source for e in examples})), pose.variance_dims,
-                          pose.residuals_deg)
+                          pose.residuals_deg, robot)

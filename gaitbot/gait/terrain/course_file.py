@@ -1,8 +1,9 @@
 """Terrain courses from TOML files a person writes by hand, checked field by field.
 
-    [course]
-    start_m = 0.0        # both heels here at the start
+    [course]             # optional, as is each of its values
+    start_m = 0.0        # both heels here at the start (default 0)
     end_m = 1.2          # the walk ends with both heels at the first foothold at or past this
+                         # (default: END_PAST_TREADS_M past the far end of the last tread)
     margin_m = 0.01      # heel and toe at least this far inside a tread's edges (default 0.01)
     # clearance_m = 0.015  swing sole above every tread edge it passes (default: the robot's)
     # max_step_m = 0.16    longest step onto another surface (default 0.75 leg lengths)
@@ -68,6 +69,9 @@ OPTIONAL_RANGES_M = {"clearance_m": (0.0, 0.5, "m"), "max_step_m": (0.005, 2.0, 
 TREAD_LENGTH_RANGE_M = (0.005, 20.0, "m")
 HEIGHT_RANGE_M = (-1.0, 1.0, "m")
 MAX_TREADS = 100
+#: Without ``end_m`` the walk crosses every tread and goes on this far past the far end of the last one,
+#: so the course's extent follows from its treads and the walk closes on the ground beyond them.
+END_PAST_TREADS_M = 0.3
 
 _COURSE_KEYS = ("start_m", "end_m", "margin_m", "clearance_m", "max_step_m", "max_rise_m")
 _TREAD_KEYS = ("start_m", "length_m", "height_m")
@@ -88,14 +92,8 @@ def load_course(path) -> Course:
     data = read_toml(path, TerrainFileError)
     fields = Fields(path, TerrainFileError)
     fields.no_unknown_keys(data, "", ("course", "search", "tread"))
-    course = fields.table(data, "course", "course", _COURSE_KEYS)
-    start = fields.number(course, "start_m", "course", within=POSITION_RANGE_M)
-    end = fields.number(course, "end_m", "course", within=POSITION_RANGE_M)
-    if end <= start:
-        raise fields.fail("course.end_m", f"{end:g} must lie beyond start_m {start:g}")
-    if end - start > MAX_COURSE_M:
-        raise fields.fail("course.end_m", f"{end:g} is {end - start:g} m beyond start_m {start:g}; a course may be at "
-                                          f"most {MAX_COURSE_M:g} m long")
+    course = fields.optional_table(data, "course", "course", _COURSE_KEYS)
+    start = fields.number(course, "start_m", "course", default=0.0, within=POSITION_RANGE_M)
     margin = fields.number(course, "margin_m", "course", non_negative=True, default=0.01, within=MARGIN_RANGE_M)
     optional = {key: fields.number(course, key, "course", positive=key != "clearance_m",
                                    non_negative=key == "clearance_m", within=OPTIONAL_RANGES_M[key])
@@ -118,5 +116,12 @@ def load_course(path) -> Course:
         terrain = Terrain(treads)
     except TerrainError as exc:
         raise TerrainFileError(path, exc.field, exc.reason) from None
+    far_end = max([start, *(t.start_m + t.length_m for t in treads)])
+    end = fields.number(course, "end_m", "course", default=far_end + END_PAST_TREADS_M, within=POSITION_RANGE_M)
+    if end <= start:
+        raise fields.fail("course.end_m", f"{end:g} must lie beyond start_m {start:g}")
+    if end - start > MAX_COURSE_M:
+        raise fields.fail("course.end_m", f"{end:g} is {end - start:g} m beyond start_m {start:g}; a course may be at "
+                                          f"most {MAX_COURSE_M:g} m long")
     return Course(str(path), terrain, start, end, margin, optional.get("clearance_m"), optional.get("max_step_m"),
                   optional.get("max_rise_m"), weights)

@@ -168,7 +168,7 @@ class TerrainStepSegment:
         s = np.linspace(0.0, s_to, samples)
         roots = pelvis(self.swing_time(s))
         sigma = warp_table(s_to, samples) if warps is WARPS else np.stack([warp(s, *w) for w in warps])
-        poses, extra = self.swing.fitted(sigma, np.broadcast_to(roots, (len(warps), samples, 2)))
+        poses, extra = self.swing.fitted(s, sigma, np.broadcast_to(roots, (len(warps), samples, 2)))
         excess, q = legs.check(poses.reshape(-1, 3), np.tile(roots, (len(warps), 1)), False)
         excess = excess.reshape(len(warps), samples).sum(axis=1)
         excess += np.maximum(extra - TIP_LIFT_SHARE * self.swing.clearance, 0.0) / self.ctx.geometry.leg_length

@@ -1,17 +1,21 @@
 """The swing foot of a terrain step: a world path from rest at lift-off to rest at landing.
 
-Path. The foot goes up, over and down: it first rises almost straight (``HOLD`` of the path has
-no forward motion), travels forward, and sets down almost straight, so a toe next to a riser or a
+Path. The foot goes up, over and down: it first rises straight (``HOLD`` of the path has no
+forward motion), travels forward, and sets down straight, so a toe next to a riser or a
 heel just past a nose never cuts the corner. The level change happens while over the higher
 surface: a rising foot reaches its new level before it travels (``LEVEL``), a falling one leaves
 it only when it has arrived. The sole levels out from its lift-off pitch early and lands flat. On
 top of that a lift, smooth and zero at both ends, is the least that keeps the sole
 
 - ``clearance`` above every tread edge it passes over (anywhere in the swing: what the course asks),
-- WINDOW_SHARE of it above the surface under heel and toe from 20% to 80% of the path (off the
-  ground, never scraping along it; less than the full clearance so that a sole tipped for the
-  ankle, or a trailing foot on a step down, need not be lifted as high as over an edge),
+- ``clearance`` above the surface under heel and toe wherever the foot moves forward
+  (CLEARANCE_WINDOW, the path between the two HOLDs: the rule every swing keeps, flat or terrain,
+  docs/gait.md; the lift is whole there, LIFT_RISE = HOLD),
 - above the terrain everywhere.
+
+The lift's shape follows time as well as the path (``lift_shape``): a timing that holds the foot back
+still lifts it off the ground at once (with a quarter-cycle hold-back on the path alone, a foot spent
+the first fifth of its swing within 0.2 mm of the ground).
 
 The sole height at every sample is linear in the lift, so the least lift is found exactly on a fine
 sampling (aiming 2% high keeps the frames between samples clear too).
@@ -40,16 +44,15 @@ import numpy as np
 
 from ..geometry import LegGeometry, foot_points, leg_ik
 from ..segments import GaitGenerationError
-from ..smooth import plateau, smootherstep
+from ..smooth import plateau, smootherstep, smoothstep
 from .model import Terrain
 
 HOLD = 0.2  # share of the path at each end with no horizontal motion (straight up, straight down)
 LEVEL = 0.45  # a rising foot reaches the new level by this share; a falling one leaves it this late
-LIFT_RISE = 0.25  # the lift rises over this share of the path (and falls over the last)
+LIFT_RISE = HOLD  # the lift rises over this share of the path (and falls over the last): whole before the foot moves on
 PITCH_SHARE = 0.3  # the sole levels out over this share of the path (and tips to its landing pitch)
 TIP_RISE = 0.1  # the ankle's tipping fades in over this share of the path (none at lift-off and landing)
-CLEARANCE_WINDOW = (0.2, 0.8)  # share of the path where the whole sole keeps WINDOW_SHARE of the clearance
-WINDOW_SHARE = 0.25
+CLEARANCE_WINDOW = (HOLD, 1.0 - HOLD)  # the path's forward part: the whole sole keeps the clearance there
 AIM = 1.02  # aim this much above the clearance (frames fall between the samples)
 SAMPLES = 801
 FIT_ROUNDS = 12  # rounds of tip-then-lift for a tipped sole (the tip grows with the lift; it settles in a few)
@@ -74,6 +77,18 @@ def warp_table(s_to: float, samples: int) -> np.ndarray:
     table = np.stack([warp(s, *w) for w in WARPS])
     table.setflags(write=False)
     return table
+
+
+def lift_shape(s, sigma, rise: float = LIFT_RISE):
+    """The lift's shape at swing time share s and path position sigma: plateau(sigma, rise), except that it
+    rises with whichever of time and path comes first and falls with whichever comes last. A timing that
+    holds the foot back on its path (a warp below the identity) then still lifts it off the ground at once,
+    and it waits in the air; where the foot moves forward (sigma in CLEARANCE_WINDOW) the shape is 1 either
+    way. It is never below plateau(sigma), so a lift found on the path alone clears the ground in time too.
+    The sole's tipping for the ankle fades in the same way (rise TIP_RISE), so that a foot lifted early is
+    tipped early too."""
+    s, sigma = np.asarray(s, dtype=float), np.asarray(sigma, dtype=float)
+    return smoothstep(np.maximum(s, sigma) / rise) * smoothstep((1.0 - np.minimum(s, sigma)) / rise)
 
 
 def smooth_clamp(x, lo: float, hi: float, soft: float = ANKLE_SOFT_RAD):
@@ -128,7 +143,7 @@ class SwingPath:
         heel, toe = foot_points(g, pose[:, :2], pose[:, 2])
         inside = (sigma >= CLEARANCE_WINDOW[0]) & (sigma <= CLEARANCE_WINDOW[1])
         aim = cl * AIM + 1e-6 * g.leg_length
-        aim_window = np.where(inside, WINDOW_SHARE * aim, 0.0)
+        aim_window = np.where(inside, aim, 0.0)
         need = np.maximum(self.terrain.height_at(heel[:, 0]) + aim_window - heel[:, 1],
                           self.terrain.height_at(toe[:, 0]) + aim_window - toe[:, 1])
         span = toe[:, 0] - heel[:, 0]
@@ -150,8 +165,9 @@ class SwingPath:
         return max(0.0, float((need[short] / shape[short]).max())) if short.any() else 0.0
 
     # --- the foot for a pelvis -------------------------------------------------------------------
-    def fitted(self, sigma, roots, extra=None):
-        """The foot at path positions sigma (w, n) with the hip at ``roots`` (w, n, 2): the sole tipped where
+    def fitted(self, s, sigma, roots, extra=None):
+        """The foot at swing time shares s (n,) and path positions sigma (w, n) (one row per timing) with the hip
+        at ``roots`` (w, n, 2): the sole tipped where
         a level one would take the ankle out of its range, lifted by ``extra`` (w,) more or, if None, by
         the least extra that keeps the tipped sole clear, found here per row of samples (each row one
         timing). Returns (poses (w, n, 3), extra (w,))."""
@@ -159,7 +175,7 @@ class SwingPath:
         w, n = sigma.shape
         flat_sigma = sigma.ravel()
         roots = np.asarray(roots, dtype=float).reshape(w * n, 2)
-        base, fade, shape = self._along(sigma)
+        base, fade, shape = self._along(s, sigma)
         pose = base.copy()
         usable = (shape > 1e-9).reshape(w, n)
         lift = np.zeros(w) if extra is None else np.broadcast_to(np.asarray(extra, dtype=float), (w,))
@@ -184,14 +200,19 @@ class SwingPath:
         pose[:, 1] = base[:, 1] + np.repeat(lift, n) * shape
         return pose.reshape(w, n, 3), lift
 
-    def _along(self, sigma):
-        """The level-sole path, the tip's fade and the lift's shape at sigma (flattened); cached for the
-        read-only tables the run asks about again and again (``warp_table``)."""
+    def _along(self, s, sigma):
+        """The lifted level-sole path, the tip's fade and the lift's shape (``lift_shape``) at time shares s and
+        path positions sigma (flattened); cached for the read-only tables the run asks about again and again
+        (``warp_table``, whose rows share one s)."""
         key = id(sigma) if not sigma.flags.writeable else None
         if key is not None and key in self._cache:
             return self._cache[key]
         flat = sigma.ravel()
-        out = (self.path(flat), plateau(flat, TIP_RISE), plateau(flat, LIFT_RISE))
+        times = np.broadcast_to(np.asarray(s, dtype=float), sigma.shape).ravel()
+        shape = lift_shape(times, flat)
+        base = self.path(flat, lift=False)
+        base[:, 1] += self.lift * shape
+        out = (base, lift_shape(times, flat, TIP_RISE), shape)
         if key is not None:
             self._cache[key] = out
         return out
@@ -202,7 +223,7 @@ class SwingPath:
         self.warp = tuple(warp_coeffs)
         s = np.linspace(0.0, 1.0, SAMPLES)
         self._pelvis = pelvis_at
-        self.extra = float(self.fitted(warp(s, *self.warp)[None], pelvis_at(s)[None])[1][0])
+        self.extra = float(self.fitted(s, warp(s, *self.warp)[None], pelvis_at(s)[None])[1][0])
 
     def __call__(self, s):
         """The foot at swing time share s: (n, 3). Before ``finalize``, the level-sole path, identity timing."""
@@ -210,7 +231,7 @@ class SwingPath:
         sigma = warp(s, *self.warp)
         if self._pelvis is None:
             return self.path(sigma)
-        return self.fitted(sigma[None], self._pelvis(s)[None], self.extra)[0][0]
+        return self.fitted(s, sigma[None], self._pelvis(s)[None], self.extra)[0][0]
 
     @property
     def total_lift(self) -> float:

@@ -143,8 +143,12 @@ def terrain_limits(ctx: GaitContext, settings: TerrainSettings, flat_max_step: f
 
 
 def plan_terrain_walk(ctx: GaitContext, terrain: Terrain, start: float, end: float, settings: TerrainSettings,
-                      flat_max_step: float) -> TerrainWalk:
-    """Footholds, segments and the trajectory for walking the course from ``start`` to ``end``."""
+                      flat_max_step: float, on_progress=None) -> TerrainWalk:
+    """Footholds, segments and the trajectory for walking the course from ``start`` to ``end``.
+
+    ``on_progress(k, n)``, if given, is told after each of the n steps and the trajectory (a progress bar:
+    a course of stairs takes seconds)."""
+    report = on_progress or (lambda k, n: None)
     footholds = plan_footholds(terrain, start, end, terrain_limits(ctx, settings, flat_max_step))
     start_hold = Foothold(start, float(terrain.height_at(start)), int(terrain.surface_index(start)))
     walk = TerrainWalk(ctx, terrain, settings, footholds)
@@ -182,6 +186,8 @@ def plan_terrain_walk(ctx: GaitContext, terrain: Terrain, start: float, end: flo
         walk.heel_strikes.append(HeelStrike(t_end, leg, target.heel_x))
         t = t_end
         rear, stance = stance, target
+        if not pending:
+            report(i + 1, len(targets) + 1)
     if pending:
         _close_run(walk, pending, pending_start)
         state = walk.segments[-1].end_state()
@@ -191,8 +197,10 @@ def plan_terrain_walk(ctx: GaitContext, terrain: Terrain, start: float, end: flo
     last = CrouchSegment(ctx, state.anchor_stance, bend=False)
     _push(walk, LevelSegment(last, stance.height))
     walk._final = LevelSegment(last, stance.height)
+    report(len(targets), len(targets) + 1)
     walk.trajectory = _trajectory(walk)
     _verify_limits(walk)
+    report(len(targets) + 1, len(targets) + 1)
     return walk
 
 

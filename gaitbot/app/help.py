@@ -1,0 +1,154 @@
+"""What ``gaitbot COMMAND --help`` says beyond the options: what the command is for, and examples.
+
+Written here, apart from the parser, so that the texts read as one piece. The examples are run by the
+tests (tests/docs/test_examples.py runs every ``$ `` line of every epilog in a temporary folder, in
+order, as the docs' commands are run), so they cannot go stale.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Descriptions and examples keep their line breaks; option help is wrapped as usual."""
+
+
+@dataclass(frozen=True)
+class CommandHelp:
+    summary: str  # one line, in the list of commands
+    description: str  # what it does and why, a few lines
+    examples: tuple[str, ...]  # command lines (without the leading "gaitbot"-less prompt), run by the tests
+    robot_examples: tuple[str, ...] = ()  # command lines that need servos at hand (not run by the tests)
+
+    @property
+    def epilog(self) -> str:
+        lines = ["examples:"] + [f"  $ {line}" for line in self.examples]
+        if self.robot_examples:
+            lines += ["examples with the servos connected (docs/bring-up.md):"]
+            lines += [f"  {line}" for line in self.robot_examples]
+        return "\n".join(lines)
+
+
+EXIT_STATUSES = """exit status:
+  0    success
+  1    the robot or the check failed: a limit broken, a bus fault, a fall in the simulation
+  2    bad input: one line naming the argument, file or field; nothing was sent to a servo
+  130  stopped by Ctrl-C (a walk brakes and ramps to standing first)
+  141  the output was closed early (e.g. piped into head)
+  143  stopped by SIGTERM (as Ctrl-C)"""
+
+DESCRIPTION = """Walking gaits for small servo bipeds: plan and generate walks (Boulic's model with exact step
+lengths, terrain, eigen-gaits), check them against the robot's limits, and stream them at the robot's
+frame rate to Dynamixel or Feetech servos, a mock bus or a simulated robot."""
+
+EPILOG = f"""{EXIT_STATUSES}
+
+examples:
+  $ gaitbot walk --dry-run --record run.jsonl
+  $ gaitbot plan --distance 1.0
+
+Each command's own --help explains it, with examples; the manual is docs/ in the source
+(docs/command-line.md lists every command)."""
+
+COMMAND_HELP = {
+    "plan": CommandHelp(
+        "print the step plan: lengths, speeds, timing, footholds",
+        "Plan a walk without moving anything: each step's length, its relative velocity RV (walking speed\n"
+        "over leg length, which sets the joint motion of Boulic's model), start and end time, and where\n"
+        "each heel lands. With --terrain: the footholds on the treads, which steps use the terrain walker,\n"
+        "how high each swing foot lifts, and the pelvis search (docs/terrain.md).",
+        ("gaitbot plan --distance 1.0",
+         "gaitbot plan --steps 0.05,0.08,0.10 --json",
+         "gaitbot plan --terrain config/terrain/kerb.toml")),
+    "generate": CommandHelp(
+        "write the trajectory (joint angles over time) to CSV or NPZ",
+        "Generate every frame of a walk (hip, knee and ankle of both legs, and the hip's path) and write\n"
+        "it to a file that plot, check, walk --trajectory and eigen fit read (docs/file-formats.md).",
+        ("gaitbot generate --distance 1.0 -o walk.csv",
+         "gaitbot generate --terrain config/terrain/kerb.toml -o kerb.csv")),
+    "plot": CommandHelp(
+        "draw a trajectory (or an eigen-gait model) to a picture",
+        "Draw joint angles, foot heights against the clearance line, stick figures and footholds of a\n"
+        "trajectory file; or, for a model from eigen fit, its mean cycle and eigen-motions.",
+        ("gaitbot generate --distance 1.0 -o walk.csv",
+         "gaitbot plot walk.csv -o walk.png")),
+    "walk": CommandHelp(
+        "walk the robot, the mock bus (--dry-run) or the simulated robot (--sim)",
+        "Check every frame against the robot's limits, then stream the walk at the robot's frame rate.\n"
+        "Nothing moves if any frame breaks a limit. On hardware, Ctrl-C or SIGTERM brake the motion and\n"
+        "ramp the robot to standing. --dry-run sends every packet through the vendor SDK to a mock bus\n"
+        "(no hardware); --sim walks a MuJoCo model of the robot and says whether it really walks.",
+        ("gaitbot walk --dry-run",
+         "gaitbot walk --distance 1.0 --dry-run --record run.jsonl",
+         "gaitbot walk --sim --distance 0.5")),
+    "check": CommandHelp(
+        "check a trajectory or a recorded run against the robot's limits",
+        "Say joint by joint whether, and where, a trajectory or a bus recording breaks a position, tick,\n"
+        "velocity or acceleration limit; for recordings also checksums, ids and frame timing.\n"
+        "Exit 0 when everything holds, 1 when something breaks, 2 for unreadable input.",
+        ("gaitbot generate --distance 0.5 -o walk.csv",
+         "gaitbot check walk.csv",
+         "gaitbot check --json walk.csv")),
+    "eigen": CommandHelp(
+        "eigen-gaits (seed 004): learn walks from examples, synthesise new ones",
+        "Learn the main ways example walks differ (eigen-motions, by functional PCA) and synthesise new\n"
+        "walks from them: at a step length between the examples', changing step length, or forced\n"
+        "through a pose (docs/eigen-gaits.md).",
+        ("gaitbot generate --steps 0.03,0.03,0.03,0.03,0.03,0.03 -o ex_0.03.npz",
+         "gaitbot generate --steps 0.07,0.07,0.07,0.07,0.07,0.07 -o ex_0.07.npz",
+         "gaitbot eigen fit ex_0.03.npz ex_0.07.npz -o model.npz",
+         "gaitbot eigen synth model.npz --step-length 0.05 -o walk.csv")),
+    "eigen fit": CommandHelp(
+        "fit an eigen-gait model to example walks",
+        "Cut each example walk into cycles (left heel strike to left heel strike), align them in time,\n"
+        "reduce the poses by PCA, fit each channel with smooth functions and keep the eigen-motions that\n"
+        "explain most of the variance. The model remembers the leg it learnt and the robot it is for.",
+        ("gaitbot generate --steps 0.03,0.03,0.03,0.03,0.03,0.03 -o ex_0.03.npz",
+         "gaitbot generate --steps 0.07,0.07,0.07,0.07,0.07,0.07 -o ex_0.07.npz",
+         "gaitbot eigen fit ex_0.03.npz ex_0.07.npz -o model.npz")),
+    "eigen synth": CommandHelp(
+        "synthesise a walk from an eigen-gait model",
+        "Make a walk from the model: at --step-length, changing to --to-step-length, or passing through\n"
+        "--pose-deg at --pose-time. It starts and ends standing and is checked like gaitbot walk checks it\n"
+        "(exit 1, with the file written, if it breaks a limit). Only for the robot the model was fitted for.",
+        ("gaitbot generate --steps 0.03,0.03,0.03,0.03,0.03,0.03 -o ex_0.03.npz",
+         "gaitbot generate --steps 0.07,0.07,0.07,0.07,0.07,0.07 -o ex_0.07.npz",
+         "gaitbot eigen fit ex_0.03.npz ex_0.07.npz -o model.npz",
+         "gaitbot eigen synth model.npz --step-length 0.05 --cycles 2 -o walk.csv")),
+    "record": CommandHelp(
+        "record a motion made by hand: torque off, positions read to a trajectory CSV",
+        "Turn torque off (after asking), read every servo's position at the robot's frame rate while you\n"
+        "move the legs, and write them as a trajectory, flushed row by row. Ctrl-C ends it (exit 0).",
+        ("gaitbot record --dry-run --duration 2 --yes -o demo.csv",)),
+    "scan": CommandHelp(
+        "list every servo that answers, at every baud rate",
+        "Ping every id at every baud rate of the configured protocol (or --baud) and list each servo that\n"
+        "answers: id, baud rate, model, firmware, present position (ticks and as its joint's angle), input\n"
+        "voltage, temperature, load, torque and hardware errors in words; then the configured joints that\n"
+        "did not answer. Reads only. Exit 0 when every configured joint answered as configured, else 1.",
+        ("gaitbot scan --dry-run",
+         "gaitbot scan --robot ax12a-biped --dry-run --json")),
+    "setup": CommandHelp(
+        "give new servos, one at a time, the config's ids and baud rate",
+        "For each joint (or each --joint), asks you to connect only that joint's servo, finds it at any id\n"
+        "and any baud rate its model can run at, and writes the joint's id and the config's baud rate\n"
+        "(torque off, the Feetech EEPROM lock, ID, Baud Rate: nothing else), then reads them back. Refuses\n"
+        "(exit 2, nothing written) when more than one servo answers or the servo is not the config's model\n"
+        "(docs/bring-up.md).",
+        ("gaitbot setup --help",),
+        ("gaitbot setup --robot config/xl430-biped.toml --port /dev/ttyUSB0",
+         "gaitbot setup --robot ax12a-biped --joint knee_pitch_left --yes --reply-timeout-ms 5")),
+    "calibrate": CommandHelp(
+        "measure each joint's zero tick and direction into a calibration file",
+        "Torque off; you hold the robot in its zero pose (legs straight, feet flat) and press Enter: the\n"
+        "present positions become the zero ticks. Then, joint by joint, you bend the joint in its positive\n"
+        "direction (told in words) and press Enter: the sign of the change is its direction, the size is\n"
+        "checked against the configured limits. Writes the calibration file, which every command applies on\n"
+        "top of the config (--calibration FILE, or <config stem>.calibration.toml beside the config).\n"
+        "Writes only Torque Enable = 0 to the servos (docs/bring-up.md).",
+        ("gaitbot calibrate --help",),
+        ("gaitbot calibrate --robot robots/mybot.toml -o robots/mybot.calibration.toml",
+         "gaitbot walk --robot robots/mybot.toml --calibration robots/mybot.calibration.toml --distance 0.5")),
+}

@@ -1,0 +1,116 @@
+"""The simulated robot's figures: flat walks of the shipped robots, and what the two walking settings of the
+configs are worth (the sim extra).
+
+    python tools/sim_figures.py               # the figures, as text
+    python tools/sim_figures.py --markdown    # the figures of docs/simulation.md (tools/figures.py)
+
+Every figure is a ``gaitbot walk --sim --json`` run through the command line itself: per robot, 1 m with the
+pitch held and with it free; the same walks with the ankle at the heel (``heel_back_m = 0``), at the servos'
+factory gains (no ``[servo] full_torque_error_deg``), and both; and toe drag (``--clearance 0``) at factory
+and at the shipped gains. The simulation is deterministic: a run gives the same figures on every machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import json
+import re
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from gaitbot.app.cli import main as gaitbot  # noqa: E402
+from gaitbot.app.progress import progress  # noqa: E402
+
+ROBOTS = ("xl430-biped", "sts3215-biped", "ax12a-biped")
+DISTANCE = "1.0"
+
+
+def variant(name: str, folder: Path, ankle_at_heel: bool, factory_gains: bool) -> str:
+    """The shipped config of ``name`` with the ankle at the heel and/or without its stiffness setting."""
+    text = (ROOT / "config" / f"{name}.toml").read_text()
+    if ankle_at_heel:
+        text = re.sub(r"(?m)^heel_back_m = .*$", "heel_back_m = 0.0", text)
+    if factory_gains:
+        text = re.sub(r"(?m)^\[servo\]\nfull_torque_error_deg = .*\n", "", text)
+    path = folder / f"{name}-{int(ankle_at_heel)}{int(factory_gains)}.toml"
+    path.write_text(text)
+    return str(path)
+
+
+def sim(*args: str) -> dict:
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        gaitbot(["walk", "--sim", "--json", *args])  # exit 1 for a fall: the JSON says so too
+    return json.loads(out.getvalue())
+
+
+def measure() -> dict:
+    runs = {}
+    with tempfile.TemporaryDirectory() as tmp, progress("simulated walks", total=7 * len(ROBOTS), unit="walk") as bar:
+        folder = Path(tmp)
+        for name in ROBOTS:
+            def run(key, *args):
+                runs[name, key] = sim(*args)
+                bar.update(1)
+
+            run("shipped", "--robot", name, "--distance", DISTANCE)
+            run("free pitch", "--robot", name, "--distance", DISTANCE, "--free-pitch")
+            for key, heel, factory in (("neither", True, True), ("ankle only", False, True), ("stiff only", True, False)):
+                run(key, "--robot", variant(name, folder, heel, factory), "--distance", DISTANCE)
+            run("drag, factory", "--robot", variant(name, folder, False, True), "--distance", DISTANCE, "--clearance", "0")
+            run("drag, shipped", "--robot", name, "--distance", DISTANCE, "--clearance", "0")
+    return runs
+
+
+def _travelled(r: dict) -> str:
+    return f"{r['distance_travelled_m']:.3f} ({100 * r['distance_travelled_m'] / r['distance_planned_m']:.0f}%)"
+
+
+def markdown(runs: dict) -> str:
+    flat = ["| robot | planned m | travelled m | fell | scuff | max slip mm | max torque / stall | "
+            "max tracking error deg | free pitch |", "|---|---|---|---|---|---|---|---|---|"]
+    for name in ROBOTS:
+        r, free = runs[name, "shipped"], runs[name, "free pitch"]
+        fell = f"fell at {free['fell_at_s']:.2f} s" if free["fell"] else "stayed up"
+        flat.append(f"| {name} | {r['distance_planned_m']:.3f} | {_travelled(r)} | {'yes' if r['fell'] else 'no'} | "
+                    f"{100 * r['scuff_fraction']:.1f}% | {1000 * r['max_slip_m']:.1f} | {r['max_torque_fraction']:.2f} | "
+                    f"{r['max_tracking_error_deg']:.1f} | {fell} |")
+    settings = ["| robot | neither | ankle a third into the foot only | stiff servos only | both (shipped) |",
+                "|---|---|---|---|---|"]
+    for name in ROBOTS:
+        settings.append(f"| {name} | " + " | ".join(_travelled(runs[name, key]) for key in
+                                                    ("neither", "ankle only", "stiff only", "shipped")) + " |")
+    drag = "; ".join(f"{name} {runs[name, 'drag, factory']['distance_travelled_m']:.3f} m, scuffing "
+                     f"{100 * runs[name, 'drag, factory']['scuff_fraction']:.0f}% of the swing time" for name in ROBOTS)
+    stiff = "; ".join(f"{name} {runs[name, 'drag, shipped']['distance_travelled_m']:.3f} m, "
+                      f"{100 * runs[name, 'drag, shipped']['scuff_fraction']:.1f}%" for name in ROBOTS)
+    blocks = {"sim-flat": "\n".join(flat), "sim-settings": "\n".join(settings),
+              "sim-toe-drag": (f"With the swing clearance turned off (`--clearance 0`), at factory gains, of "
+                               f"{DISTANCE} m: {drag}. With the shipped stiff servos: {stiff}.")}
+    return "\n".join(f"<!-- figure {k} -->\n{v}\n<!-- /figure -->" for k, v in blocks.items())
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--markdown", action="store_true", help="print the docs' figures (tools/figures.py)")
+    args = parser.parse_args(argv)
+    runs = measure()
+    if args.markdown:
+        print(markdown(runs))
+        return 0
+    for (name, key), r in runs.items():
+        print(f"{name:14s} {key:14s} planned {r['distance_planned_m']:.3f} m, travelled {_travelled(r)}, "
+              f"fell {r['fell']} {r['fell_at_s']}, scuff {100 * r['scuff_fraction']:.1f}%, slip "
+              f"{1000 * r['max_slip_m']:.1f} mm, torque {r['max_torque_fraction']:.2f}, tracking "
+              f"{r['max_tracking_error_deg']:.1f} deg")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
