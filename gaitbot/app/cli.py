@@ -34,6 +34,8 @@ def _walk_inputs(p: argparse.ArgumentParser) -> None:
     p.add_argument("--foot", type=float, help="foot length in metres")
     p.add_argument("--clearance", type=float, help="swing-foot clearance in metres (default: the robot's)")
     p.add_argument("--rate", type=float, help="frame rate in Hz (default: the robot's rate_hz)")
+    p.add_argument("--cycle", type=float, metavar="SECONDS", help="walking cycle (two steps) in seconds "
+                   "(default: the robot's cycle_s)")
     p.add_argument("--terrain", metavar="FILE", help="walk a terrain course (TOML, see config/terrain/) instead of "
                    "--steps/--distance")
 
@@ -51,6 +53,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("generate", help="write the trajectory to CSV or NPZ")
     _walk_inputs(p)
     p.add_argument("-o", "--output", required=True, help="walk.csv or walk.npz")
+    p.add_argument("--goals", action="store_true", help="write the goal angles a walk sends (servo-sag "
+                   "feedforward included) instead of the planned angles")
 
     p = sub.add_parser("plot", help="draw a trajectory file to a PNG")
     p.add_argument("file", help="trajectory (.csv or .npz)")
@@ -74,8 +78,12 @@ def build_parser() -> argparse.ArgumentParser:
                    "eigen synth, record) instead of --steps/--distance; it streams at its own frame rate")
     p.add_argument("--sim", action="store_true",
                    help="walk the simulated robot (MuJoCo, the sim extra) and measure whether it really walks")
-    p.add_argument("--free-pitch", action="store_true", help="--sim: let the torso pitch freely (default: held by a boom)")
-    p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (side view)")
+    p.add_argument("--boom", action="store_true", help="--sim: the torso rides a boom (slides forward and up, "
+                   "pitch held) instead of floating free")
+    p.add_argument("--free-pitch", action="store_true", help="--sim: the boom, with the torso free to pitch on it")
+    p.add_argument("--push", type=float, metavar="N_S", help="--sim: push the torso sideways with this impulse "
+                   "(N s, positive to the left) in the middle of a step half-way through the walk")
+    p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (three-quarter view)")
     p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
 
     p = sub.add_parser("check", help="check a trajectory or a recorded run against the robot's limits")

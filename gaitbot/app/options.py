@@ -75,6 +75,10 @@ def gait_source(args) -> GaitSource:
     rate = getattr(args, "rate", None)
     positive_option(rate, "--rate", "a positive frame rate in Hz")
     settings = walk_settings(robot, rate)
+    cycle = getattr(args, "cycle", None)
+    positive_option(cycle, "--cycle", "a positive number of seconds (two steps)")
+    if cycle is not None:
+        settings = WalkSettings(cycle, settings.rate_hz, settings.clearance)
     clearance = getattr(args, "clearance", None)
     if clearance is not None:
         if not (math.isfinite(clearance) and clearance >= 0):
@@ -82,6 +86,8 @@ def gait_source(args) -> GaitSource:
         settings = WalkSettings(settings.cycle_s, settings.rate_hz, clearance)
     reachable = make_context(geometry, settings).inverse.max_step_length
     max_step = robot.gait.max_step_m if robot_for_limits is not None else reachable
+    if robot_for_limits is not None and robot.is_3d:  # its max_step_m is the default; the leg's reach the limit
+        return GaitSource(geometry, settings, reachable, robot, default_step_m=min(max_step, reachable))
     return GaitSource(geometry, settings, min(max_step, reachable), robot_for_limits)
 
 
@@ -109,7 +115,8 @@ def step_lengths(args, source: GaitSource) -> list[float]:
         distance = args.distance
         if distance is None or not math.isfinite(distance) or distance <= 0:
             raise UsageError(f"--distance must be a positive number of metres, got {distance!r}")
-        max_step = source.max_step_m if args.max_step is None else args.max_step
+        default = source.default_step_m if source.default_step_m is not None else source.max_step_m
+        max_step = default if args.max_step is None else args.max_step
         if not math.isfinite(max_step) or max_step <= 0:
             raise UsageError(f"--max-step must be a positive number of metres, got {max_step!r}")
         if max_step > source.max_step_m * (1 + 1e-12):
@@ -120,7 +127,8 @@ def step_lengths(args, source: GaitSource) -> list[float]:
         if value < 0:
             raise UsageError(f"--steps: step {i} is {value:g} m; step lengths must be 0 or more")
         if value > source.max_step_m * (1 + 1e-12):
-            what = "max_step_m in the robot config" if source.robot is not None else "the leg's reachable maximum"
+            what = ("max_step_m in the robot config" if source.robot is not None and not source.balanced
+                    else "the leg's reachable maximum")
             raise UsageError(f"--steps: step {i} is {value:g} m, longer than {source.max_step_m:.4g} m ({what})")
     sigma = getattr(args, "perturb", None)
     if sigma:

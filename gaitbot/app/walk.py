@@ -6,6 +6,7 @@ bus behind the LimitGuard; docs/bus-faults.md says what happens when the bus fai
 
 from __future__ import annotations
 
+import math
 import sys
 
 from gaitbot.app.hardware import serial_port, warn_about_latency
@@ -46,7 +47,7 @@ def run(args) -> int:
     config = load_robot(args.robot)
     check_rate_option(config, args.rate)
     args.robot = str(config.path)
-    source, walker, trajectory = trajectory_for_robot(args)
+    source, walker, trajectory = trajectory_for_robot(args, goals=True)  # what the servos are sent
     report = preflight(config, trajectory)
     if not report.ok:
         raise UsageError(f"walk refused before anything moved: {report.first_error}")
@@ -59,7 +60,9 @@ def run(args) -> int:
     if args.sim:
         from gaitbot.sim.walk import SimWalk, walk_plan  # MuJoCo: only with --sim
 
-        sim = SimWalk(config, source.settings.rate_hz, walk_plan(walker, trajectory), args.free_pitch, args.video)
+        planned = walker.walk.trajectory() if hasattr(walker, "walk") else trajectory
+        sim = SimWalk(config, source.settings.rate_hz, walk_plan(walker, planned), sim_support(args, config),
+                      args.video, args.push)
     hardware = not (args.dry_run or args.sim)
     port = serial_port(config, args.port, dry_run=not hardware)
     clock = MonotonicClock() if (hardware or args.realtime) else VirtualClock()
@@ -91,11 +94,12 @@ def run(args) -> int:
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     if sim is not None and args.json:
-        sim.print_report(True, result.outcome)
-        return result.exit_code
+        return sim_exit_code(sim.print_report(True, result.outcome), result.exit_code)
     if sim is not None:
+        torso = {"free": "free-floating torso", "boom": "torso on a boom, pitch held",
+                 "boom-pitch": "torso on a boom, free to pitch"}[sim.robot.support]
         mode = (f"simulated robot (MuJoCo; {config.bus.backend} packets on a simulated bus, simulated clock; "
-                f"torso {'free to pitch' if args.free_pitch else 'on a boom, pitch held'})")
+                f"{torso})")
     elif not args.dry_run:
         mode = f"{config.bus.backend} on {port}"
     elif args.realtime:
@@ -109,15 +113,31 @@ def run(args) -> int:
     if args.record:
         print(f"recording: {args.record}")
     if sim is not None:
-        sim.print_report(False, result.outcome)
+        report = sim.print_report(False, result.outcome)
+        if report.fell:
+            print(f"The robot fell {report.fall_direction} at {report.fell_at_s:.2f} s ({report.fall_reason}).")
+        return sim_exit_code(report, result.exit_code)
     return result.exit_code
+
+
+def sim_support(args, config) -> str:
+    """How the simulated torso is held: free-floating unless --boom or --free-pitch asks for the boom (or the
+    config says the robot walks on one, ``[robot] boom = true``)."""
+    if args.free_pitch:
+        return "boom-pitch"
+    return "boom" if (args.boom or config.boom) else "free"
+
+
+def sim_exit_code(report, session_exit_code: int) -> int:
+    """A fall is a failure (status 1), whatever the session's outcome; else the session's status."""
+    return 1 if report.fell and session_exit_code == 0 else session_exit_code
 
 
 def check_sim_arguments(args) -> None:
     """Refuse what a simulated walk cannot honour, and a missing MuJoCo, before any work is done."""
     sim = getattr(args, "sim", False)
     if not sim:
-        for flag in ("free_pitch", "video", "json"):
+        for flag in ("boom", "free_pitch", "push", "video", "json"):
             if getattr(args, flag, None):
                 raise UsageError(f"--{flag.replace('_', '-')}: only with --sim (a simulated walk)")
         return
@@ -132,6 +152,12 @@ def check_sim_arguments(args) -> None:
     for flag, why in refused.items():
         if getattr(args, flag, None):
             raise UsageError(f"--{flag.replace('_', '-')}: {why}")
+    push = getattr(args, "push", None)
+    if push is not None:
+        if not math.isfinite(push) or push == 0:
+            raise UsageError(f"--push must be a non-zero impulse in N s (positive to the left), got {push!r}")
+        if getattr(args, "boom", False) or getattr(args, "free_pitch", False):
+            raise UsageError("--push: a sideways push needs a free-floating torso (the boom holds it sideways)")
     import_mujoco()
     if getattr(args, "video", None):
         check_video_path(args.video)

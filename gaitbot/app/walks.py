@@ -15,6 +15,7 @@ from gaitbot.gait.terrain.footholds import CourseError
 from gaitbot.gait.terrain.walk import plan_terrain_walk
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.gait.walker import OnlineWalker, WalkSettings, make_context, plan_walk, trajectory_of
+from gaitbot.robot.balanced_walk import BalancedPlan, balanced_gait_settings, plan_balanced
 from gaitbot.robot.walk_settings import GaitSource, terrain_settings
 
 
@@ -65,12 +66,33 @@ def trajectory_file_walk(args) -> tuple[GaitSource, FileWalk, Trajectory]:
         FileWalk(tuple(trajectory.heel_strikes)), trajectory
 
 
-def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:
+def build_balanced_walk(args, source: GaitSource) -> BalancedPlan:
+    """The balanced walk of a robot whose legs roll: its steps, with --cycle, --rate, --max-step and
+    --clearance over the config's [gait]; the servos' speed fitted (gaitbot.gait.balance.speed_fit)."""
+    steps = step_lengths(args, source)
+    longest = max([args.max_step or source.default_step_m or 0.0, *steps])
+    gait = balanced_gait_settings(source.robot, cycle_s=source.settings.cycle_s, rate_hz=source.settings.rate_hz,
+                                  max_step_m=longest, clearance_m=source.settings.clearance)
+    return plan_balanced(source.robot, steps, gait)
+
+
+def trajectory_for_robot(args, goals: bool = False) -> tuple[GaitSource, OnlineWalker, Trajectory]:
+    """The walk the options ask for: (where its settings come from, its walker, its trajectory). A
+    balanced walk's trajectory holds the planned angles, or with ``goals`` the angles its servos are sent
+    (servo-sag feedforward included); a planar walk's are the same."""
     if getattr(args, "trajectory", None) is not None:
         return trajectory_file_walk(args)
     if getattr(args, "terrain", None) is not None:
+        source = gait_source(args)
+        if source.balanced:
+            raise UsageError(f"--terrain: robot {source.robot.name} walks with the balanced walker, which walks "
+                             "on the flat only (terrain courses are walked by the planar walker)")
         source, walk = build_terrain_walk(args)
         return source, walk, walk.trajectory
+    source = gait_source(args)
+    if source.balanced:
+        plan = build_balanced_walk(args, source)
+        return source, plan, plan.walk.trajectory(goals=goals)
     source, walker = build_walk(args)
     return source, walker, trajectory_of(walker)
 
