@@ -1,6 +1,8 @@
 """The balanced walk's plan, frame by frame: ZMP reference, feet, load share and the swing paths.
 
-A walk (docs/balance.md) starts standing with knees slightly bent (STAND_KNEE_DEG), crouches to the
+A walk (docs/balance.md) starts standing straight (every joint at 0, the servos' standing pose), bends
+its knees slightly (STAND_KNEE_DEG, over RISE_S: both feet flat, the pelvis moved straight to where the
+balance plan begins; walker.py adds these frames and their mirror at the end), crouches to the
 walking height (SETTLE_S), pauses, shifts its weight onto the first stance foot (a whole step of
 double support), walks the queued steps, closes the trailing foot beside the leading one, moves the
 ZMP back between the feet, stands still (END_STAND_S) and rises. ``StepPlanner`` appends these blocks
@@ -23,17 +25,21 @@ from gaitbot.gait.body import SIDE_SIGN, BodyGeometry
 from gaitbot.gait.joints import SIDES
 
 SETTLE_S = 0.5  # stand -> crouch and back, both feet flat
+RISE_S = 0.4  # straight legs (all joints 0) <-> standing with STAND_KNEE_DEG, both feet flat
 STAND_KNEE_DEG = 10.0  # standing knees: bent this much, so the legs reach wherever the CoM puts the root
 START_PAUSE_S = 0.3
 END_STAND_S = 1.0
 PLAN_KEYS = ("zmp", "ankles", "root_z", "share_left", "cops", "swinging")
 
 
-def feedforward_weight(frame, rate_hz: float):
-    """The share of the sag feedforward in the goals of frame(s) ``frame``: 0 at the first frame, 1 after
-    the first crouch (SETTLE_S). The walk's first goals are then its planned first pose, which a robot
-    placed in that pose is already at (no ramp before the walk, so its times stay the plan's)."""
-    return smootherstep(np.asarray(frame, dtype=float) / (SETTLE_S * rate_hz))
+def feedforward_weight(frame, last_frame: float, rate_hz: float):
+    """The share of the sag feedforward in the goals of the balance plan's frame(s) ``frame``: 0 at its
+    first and last frames, 1 from the end of the first crouch (SETTLE_S) to the start of the last rise.
+    The walk's first and last goals are then its planned standing poses (all zeros), where the servos
+    stand (no ramp before or after the walk: a recording holds exactly the trajectory)."""
+    frame = np.asarray(frame, dtype=float)
+    n = SETTLE_S * rate_hz
+    return np.minimum(smootherstep(frame / n), smootherstep((last_frame - frame) / n))
 
 
 def crouch_hip_height_m(geometry: BodyGeometry, knee_deg: float) -> float:

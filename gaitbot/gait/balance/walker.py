@@ -33,7 +33,9 @@ from gaitbot.gait.balance.flat_frame import FlatFootBody
 from gaitbot.gait.balance.placement import MAX_PLACEMENT_ITERATIONS, PLACEMENT_TOLERANCE_M, WholeBody, multibody_zmp
 from gaitbot.gait.balance.preview import PreviewController, preview_gains, preview_offline
 from gaitbot.gait.balance.settings import BalanceSettings
-from gaitbot.gait.balance.step_plan import START_PAUSE_S, Landing, PlanBlocks, StepPlanner, feedforward_weight
+from gaitbot.gait.balance.step_plan import (RISE_S, START_PAUSE_S, Landing, PlanBlocks, StepPlanner,
+                                           feedforward_weight)
+from gaitbot.gait.balance.zmp_reference import smootherstep
 from gaitbot.gait.balance.swing import swing_shapes
 from gaitbot.gait.balance.zmp_reference import Timing
 from gaitbot.gait.body import SIDE_SIGN, BodyModel
@@ -136,8 +138,15 @@ class BalancedWalker:
         self._blocks_done = 0
         self._arrays: dict = {}
         self._commit()
-        self._k = 0
+        self._k = 0  # the balance plan's next frame
+        self._out = 0  # the walk's next frame (rise, balance plan, lower)
         self._primed = False
+        # Rising from straight legs to where the balance plan starts (its first CoM is the ZMP reference's)
+        self.rise_frames = max(1, round(RISE_S * gait.rate_hz))
+        root0, _, _ = self.whole.place(self._arrays["zmp"][:1], ankles0[None], self._arrays["root_z"][:1],
+                                       self.standing_offset, self.com_slope)
+        self._rise = self.straight_path(root0[0], ankles0, rising=True)
+        self._lower = None
 
     @property
     def period_s(self) -> float:
@@ -165,14 +174,30 @@ class BalancedWalker:
         self.finished = True
         self._commit()
 
+    def straight_path(self, root_m, ankles, rising: bool) -> tuple[np.ndarray, np.ndarray]:
+        """(roots (n, 3), angles (n, 12)) between straight legs over ``ankles`` (both feet flat, every joint
+        0) and the pose whose root is ``root_m``: rising, from straight up to just before that pose;
+        else from just after it down to straight. The pelvis moves on a straight line (smootherstep in
+        time), the legs by the IK: the feet stay exactly where they are."""
+        g = self.body.geometry
+        straight = np.array([ankles[:, 0].mean(), 0.0, g.standing_root_height_m])
+        n = self.rise_frames
+        tau = np.arange(n) / n if rising else np.arange(1, n + 1) / n
+        w = smootherstep(tau)[:, None]
+        roots = (straight + w * (root_m - straight)) if rising else (root_m + w * (straight - root_m))
+        q = self.whole.legs(roots, np.repeat(np.asarray(ankles)[None], n, 0))
+        q[0 if rising else -1] = 0.0  # exactly the servos' standing pose
+        return roots, q
+
     def _record(self, landing: Landing, closing: bool) -> None:
         g = self.body.geometry
-        t = landing.frame / self.rate_hz
+        t = (landing.frame + self.rise_frames) / self.rate_hz
         heel_x = landing.ankle_x_m - g.heel_back_m
         sole_y = landing.ankle_y_m + SIDE_SIGN[landing.side] * g.sole_outward_m
         self.heel_strikes.append(HeelStrike(t, landing.side, heel_x, sole_y))
         self.planned_steps.append(PlannedStep(len(self.planned_steps) + 1, landing.side, landing.length_m, None,
-                                              landing.start_frame / self.rate_hz, t, heel_x, closing))
+                                              (landing.start_frame + self.rise_frames) / self.rate_hz, t, heel_x,
+                                              closing))
 
     def _commit(self) -> None:
         """Refresh the plan arrays: the planned frames, then (until the walk is closed) the provisional
@@ -295,6 +320,26 @@ class BalancedWalker:
 
     def next_frame(self):
         """(t_s, q_rad (12,), goal_rad (12,), root_m (3,)) of the next frame, or None after the last."""
+        j = self._out
+        if j < self.rise_frames:
+            roots, q = self._rise
+            frame = (q[j].copy(), q[j].copy(), roots[j].copy())
+        else:
+            frame = self._balance_frame()
+            if frame is None:
+                if self._lower is None:
+                    self._lower = self.straight_path(self._last_root, self._ext["ankles"][self._committed - 1],
+                                                     rising=False)
+                i = j - self.rise_frames - self._committed
+                if i >= self.rise_frames:
+                    return None
+                roots, q = self._lower
+                frame = (q[i].copy(), q[i].copy(), roots[i].copy())
+        self._out += 1
+        return (j / self.rate_hz, *frame)
+
+    def _balance_frame(self):
+        """The balance plan's next frame: (q, goal, root), or None after its last."""
         if not self._primed:
             self._prime()
         k = self._k
@@ -321,10 +366,12 @@ class BalancedWalker:
             torque = flat.gravity_torques(q, float(self._arrays["share_left"][k]),
                                           ((cops[0, 0] - root[0], cops[0, 1] - root[1]),
                                            (cops[1, 0] - root[0], cops[1, 1] - root[1])))
-            w = float(feedforward_weight(k, self.rate_hz))
+            last = self._committed - 1 if self.finished else math.inf
+            w = float(feedforward_weight(k, last, self.rate_hz))
             goal = [a + w * t / kp for a, t, kp in zip(q, torque, self.kp_nm_per_rad)]
         self._k += 1
-        return k / self.rate_hz, np.array(q), np.array(goal), np.array(root)
+        self._last_root = np.array(root)
+        return np.array(q), np.array(goal), np.array(root)
 
 
 def plan_balanced_walk(body: BodyModel, step_lengths, gait: BalancedGaitSettings,
@@ -348,7 +395,7 @@ def generate_balanced_walk(body: BodyModel, step_lengths, gait: BalancedGaitSett
 
 def walk_of(walker: BalancedWalker) -> BalancedWalk:
     """Every frame of a closed walker that has handed out none, computed offline."""
-    if not walker.finished or walker._k:
+    if not walker.finished or walker._out:
         raise RuntimeError("walk_of needs a closed walker that has not walked")
     a = walker.plan_arrays()
     whole, gains = walker.whole, walker.gains
@@ -360,16 +407,31 @@ def walk_of(walker: BalancedWalker) -> BalancedWalk:
     error = multibody_zmp(np.concatenate([points[:1], points, points[-1:]]), whole.point_masses_kg, dt) - a["zmp"]
     com_xy = com1 + preview_offline(gains, -error, com_xy0=np.zeros(2))
     root, q, residual = whole.place(com_xy, a["ankles"], a["root_z"], walker.standing_offset, walker.com_slope)
-    _check_limits(walker, q)
     goals = q
     if walker.feedforward:
-        w = feedforward_weight(np.arange(n), walker.rate_hz)[:, None]
+        w = feedforward_weight(np.arange(n), n - 1, walker.rate_hz)[:, None]
         goals = q + w * (whole.sag_goals(q, a["share_left"], a["cops"], root, walker.kp_nm_per_rad) - q)
+    # the rise from straight legs before the balance plan, and the way back down after it
+    rise_root, rise_q = walker._rise
+    lower_root, lower_q = walker.straight_path(root[-1], a["ankles"][-1], rising=False)
+    m = walker.rise_frames
+
+    def framed(before, middle, after):
+        return np.concatenate([before, middle, after])
+
+    root = framed(rise_root, root, lower_root)
+    q = framed(rise_q, q, lower_q)
+    goals = framed(rise_q, goals, lower_q)
+    _check_limits(walker, q)
+    _check_limits(walker, goals)
+    ankles = framed(np.repeat(a["ankles"][:1], m, 0), a["ankles"], np.repeat(a["ankles"][-1:], m, 0))
+    zmp_ref = framed(np.repeat(a["zmp"][:1], m, 0), a["zmp"], np.repeat(a["zmp"][-1:], m, 0))
+    swinging = framed(np.zeros(m, np.int8), a["swinging"], np.zeros(m, np.int8))
     com = root + whole.mass.com_in_root(q)
     points = whole.link_points(root, q)
     zmp_plan = multibody_zmp(np.concatenate([points[:1], points, points[-1:]]), whole.point_masses_kg, dt)
-    return BalancedWalk(np.arange(n) / walker.rate_hz, q, goals, root, com, a["zmp"], zmp_plan, a["ankles"],
-                        a["swinging"], tuple(walker.heel_strikes), tuple(walker.planned_steps), residual)
+    return BalancedWalk(np.arange(len(q)) / walker.rate_hz, q, goals, root, com, zmp_ref, zmp_plan, ankles,
+                        swinging, tuple(walker.heel_strikes), tuple(walker.planned_steps), residual)
 
 
 def _check_limits(walker: BalancedWalker, q) -> None:
@@ -379,6 +441,6 @@ def _check_limits(walker: BalancedWalker, q) -> None:
     bad = (q < np.asarray(lower) - 1e-9) | (q > np.asarray(upper) + 1e-9)
     if bad.any():
         frame, joint = np.argwhere(bad)[0]
-        raise BalancedWalkError(f"frame {frame} ({frame / walker.rate_hz:.2f} s): {LEG_JOINTS[joint]} would be "
+        raise BalancedWalkError(f"frame {frame} ({frame / walker.rate_hz:.2f} s): {LEG_JOINTS[joint]} would go to "
                                 f"{math.degrees(q[frame, joint]):.1f} deg, outside its limits "
                                 f"{math.degrees(lower[joint]):.1f}..{math.degrees(upper[joint]):.1f} deg")
