@@ -176,8 +176,9 @@ class StepPlanner:
         ankles[:, i, 1] = old.y_m + p * (new.y_m - old.y_m)
         ankles[:, i, 2] = g.ankle_height_m + h
         ankles[-1, i] = [new.x_m, new.y_m, g.ankle_height_m]  # lands exactly on its foothold
-        blocks.add(np.repeat(target[None], n_ss, 0), ankles, self.walk_root_z, share_target,
-                   np.repeat(feet_cops[None], n_ss, 0), 1 + i)
+        cops = np.repeat(feet_cops[None], n_ss, 0)
+        cops[:, i] += ankles[:, i, :2] - feet_ankles[i, :2]  # the swing foot's point goes with it
+        blocks.add(np.repeat(target[None], n_ss, 0), ankles, self.walk_root_z, share_target, cops, 1 + i)
         state.feet[swing_side] = new
         state.zmp_now = target
         state.share_left = share_target

@@ -46,6 +46,21 @@ from gaitbot.gait.segments import GaitGenerationError
 from gaitbot.gait.trajectory import HeelStrike, Trajectory
 
 STEP_LENGTH_TOLERANCE_M = 1e-12
+FEEDFORWARD_SMOOTHING_S = 0.1
+"""The sag feedforward splits the weight between the feet by the planned load share averaged over +- this:
+a short double support (2 frames at 0.2 m/s) would otherwise swing the stance joints' offsets across in
+two frames, asking the servos for more speed than the motion itself."""
+
+
+def smoothed_share(share, rate_hz: float, index=None):
+    """The load share averaged over +- FEEDFORWARD_SMOOTHING_S (edges held), at every frame or at ``index``."""
+    half = max(0, round(FEEDFORWARD_SMOOTHING_S * rate_hz))
+    share = np.asarray(share, dtype=float)
+    if index is not None:
+        window = np.clip(np.arange(index - half, index + half + 1), 0, len(share) - 1)
+        return float(share[window].mean())
+    padded = np.concatenate([np.repeat(share[:1], half), share, np.repeat(share[-1:], half)])
+    return np.convolve(padded, np.ones(2 * half + 1) / (2 * half + 1), mode="valid")
 
 
 class BalancedWalkError(GaitGenerationError):
@@ -363,7 +378,7 @@ class BalancedWalker:
         goal = q
         if self.feedforward:
             cops = self._arrays["cops"][k]
-            torque = flat.gravity_torques(q, float(self._arrays["share_left"][k]),
+            torque = flat.gravity_torques(q, smoothed_share(self._ext["share_left"], self.rate_hz, k),
                                           ((cops[0, 0] - root[0], cops[0, 1] - root[1]),
                                            (cops[1, 0] - root[0], cops[1, 1] - root[1])))
             last = self._committed - 1 if self.finished else math.inf
@@ -410,7 +425,8 @@ def walk_of(walker: BalancedWalker) -> BalancedWalk:
     goals = q
     if walker.feedforward:
         w = feedforward_weight(np.arange(n), n - 1, walker.rate_hz)[:, None]
-        goals = q + w * (whole.sag_goals(q, a["share_left"], a["cops"], root, walker.kp_nm_per_rad) - q)
+        share = smoothed_share(a["share_left"], walker.rate_hz)
+        goals = q + w * (whole.sag_goals(q, share, a["cops"], root, walker.kp_nm_per_rad) - q)
     # the rise from straight legs before the balance plan, and the way back down after it
     rise_root, rise_q = walker._rise
     lower_root, lower_q = walker.straight_path(root[-1], a["ankles"][-1], rising=False)
