@@ -114,13 +114,15 @@ def plan_balanced(config: RobotConfig, step_lengths, gait: BalancedGaitSettings 
     cycle or step would ask a joint for more than its max_velocity_dps (gaitbot.gait.balance.speed_fit)."""
     check_balanced_robot(config)
     gait = gait or balanced_gait_settings(config)
+    options = dict(limits_rad=leg_limits_rad(config), kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
     if speed_fit:
-        fit = fit_to_servo_speed(config.body, gait, config.balance, velocity_limit_dps(config))
-    else:
-        fit = SpeedFit(config.balance, gait, float("nan"), velocity_limit_dps(config), 0)
-    walker = plan_balanced_walk(config.body, step_lengths, fit.gait, fit.balance, limits_rad=leg_limits_rad(config),
-                                kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
-    return BalancedPlan(walk_of(walker), fit, walker)
+        fit = fit_to_servo_speed(config.body, gait, config.balance, velocity_limit_dps(config), step_lengths,
+                                 **options)
+        return BalancedPlan(fit.walk, fit, fit.walker)
+    walker = plan_balanced_walk(config.body, step_lengths, gait, config.balance, **options)
+    walk = walk_of(walker)
+    return BalancedPlan(walk, SpeedFit(config.balance, gait, float("nan"), velocity_limit_dps(config), 0, walk, walker),
+                        walker)
 
 
 def with_balance(config: RobotConfig, **changes) -> RobotConfig:
