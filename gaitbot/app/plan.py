@@ -75,6 +75,7 @@ def balanced_plan_summary(source: GaitSource, plan) -> dict:
         "n_steps": len(steps),
         "duration_s": float(walk.t_s[-1]),
         "n_frames": len(walk.t_s),
+        "crouch_knee_deg": fit.balance.crouch_knee_deg,
         "double_support_share": fit.balance.double_support_share,
         "progression_end": fit.balance.progression_end,
         "clearance_m": fit.gait.clearance_m,
