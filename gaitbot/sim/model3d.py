@@ -105,8 +105,8 @@ def build_mjcf_3d(config: RobotConfig, drives: tuple[JointDrive, ...], rate_hz: 
     by_name = {d.name: d for d in drives}
     timestep = 1.0 / (rate_hz * substeps_per_frame(rate_hz))
     radius = capsule_radius_m(config)
-    torso_com_z = float(config.body.torso.com_m[2])
     torso_half = (max(g.foot_m / 3, 0.02), g.hip_width_m / 2 + radius, 0.3 * g.leg_length_m)
+    torso_centre_z = torso_half[2] - g.hip_below_root_m  # a box standing on the hips
     if support == "free":
         root_joints = '<freejoint name="root"/>'
     else:
@@ -136,7 +136,7 @@ def build_mjcf_3d(config: RobotConfig, drives: tuple[JointDrive, ...], rate_hz: 
     <body name="torso" pos="0 0 {_f(g.standing_root_height_m)}">
       {root_joints}
       {_inertial(config.body.torso, True)}
-      <geom name="torso" type="box" pos="0 0 {_f(torso_com_z)}" size="{_f(*torso_half)}" mass="0" rgba="0.3 0.45 0.7 1"/>
+      <geom name="torso" type="box" pos="0 0 {_f(torso_centre_z)}" size="{_f(*torso_half)}" mass="0" rgba="0.3 0.45 0.7 1"/>
       {legs}
     </body>
   </worldbody>
