@@ -7,7 +7,6 @@ the gait's to 1e-9."""
 from __future__ import annotations
 
 import json
-import math
 import subprocess
 import sys
 

@@ -30,14 +30,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from gaitbot.gait.balance.flat_frame import FlatFootBody
-from gaitbot.gait.balance.placement import MAX_PLACEMENT_ITERATIONS, PLACEMENT_TOLERANCE_M, WholeBody, multibody_zmp
+from gaitbot.gait.balance.placement import (MAX_PLACEMENT_ITERATIONS, PLACEMENT_TOLERANCE_M, WholeBody,
+                                            multibody_zmp)
 from gaitbot.gait.balance.preview import PreviewController, preview_gains, preview_offline
 from gaitbot.gait.balance.settings import BalanceSettings
 from gaitbot.gait.balance.step_plan import (RISE_S, START_PAUSE_S, Landing, PlanBlocks, StepPlanner,
                                            feedforward_weight)
-from gaitbot.gait.balance.zmp_reference import smootherstep
 from gaitbot.gait.balance.swing import swing_shapes
-from gaitbot.gait.balance.zmp_reference import Timing
+from gaitbot.gait.balance.zmp_reference import Timing, smootherstep
 from gaitbot.gait.body import SIDE_SIGN, BodyModel
 from gaitbot.gait.geometry import LegGeometry
 from gaitbot.gait.joints import LEG_JOINTS
