@@ -339,6 +339,7 @@ class BalancedWalker:
         if j < self.rise_frames:
             roots, q = self._rise
             frame = (q[j].copy(), q[j].copy(), roots[j].copy())
+            self._warm_up(j)
         else:
             frame = self._balance_frame()
             if frame is None:
@@ -352,6 +353,14 @@ class BalancedWalker:
                 frame = (q[i].copy(), q[i].copy(), roots[i].copy())
         self._out += 1
         return (j / self.rate_hz, *frame)
+
+    def _warm_up(self, j: int) -> None:
+        """While rising (frames that cost nothing), run the first preview stage a share of the horizon
+        ahead each frame, so that the balance plan's first frame does not pay for a whole horizon."""
+        if not self._primed:
+            self._prime()
+        ahead = self.gains.horizon_frames + 2
+        self._stage1_until(math.ceil((j + 1) * ahead / self.rise_frames) - 1)
 
     def _balance_frame(self):
         """The balance plan's next frame: (q, goal, root), or None after its last."""
