@@ -128,15 +128,24 @@ class FlatFootBody:
         """Root (x, y, z), angles and residual putting the whole CoM at (com_x, com_y) (as
         gaitbot.gait.balance.placement.WholeBody.place, one frame)."""
         rx, ry = com_x + guess_dx, com_y + guess_dy
+        sx = sy = slope
+        last = None
         residual = math.inf
         q: list[float] = []
         for _ in range(max_iterations):
             q = self.legs((rx, ry, root_z), ankles)
             cx, cy, _ = self.com_in_root(q)
-            ex, ey = com_x - (rx + cx), com_y - (ry + cy)
+            cx, cy = rx + cx, ry + cy
+            ex, ey = com_x - cx, com_y - cy
             residual = max(abs(ex), abs(ey))
             if residual < tolerance_m:
                 break
-            rx += ex / slope
-            ry += ey / slope
+            if last is not None:  # secant slopes, where the root moved enough to measure them
+                if abs(rx - last[0]) > 1e-9:
+                    sx = (cx - last[2]) / (rx - last[0])
+                if abs(ry - last[1]) > 1e-9:
+                    sy = (cy - last[3]) / (ry - last[1])
+            last = (rx, ry, cx, cy)
+            rx += ex / sx
+            ry += ey / sy
         return (rx, ry, root_z), q, residual
