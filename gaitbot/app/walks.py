@@ -3,6 +3,7 @@ plan and a trajectory, for ``plan``, ``generate`` and ``walk``."""
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -76,6 +77,18 @@ def build_balanced_walk(args, source: GaitSource) -> BalancedPlan:
     return plan_balanced(source.robot, steps, gait)
 
 
+def speed_fit_note(walker) -> str | None:
+    """One line when a balanced walk's settings were relaxed to fit the servos' speed (else None)."""
+    fit = getattr(walker, "fit", None)
+    if fit is None or fit.relaxed == 0:
+        return None
+    b, g = fit.balance, fit.gait
+    return (f"the servos' max_velocity_dps ({fit.limit_dps:g}) needed a gentler walk at this cycle and step: crouch "
+            f"{b.crouch_knee_deg:g} deg, double support {100 * b.double_support_share:g}%, progression done at "
+            f"{100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm (peak "
+            f"{fit.peak_dps:.0f} deg/s; docs/balance.md)")
+
+
 def trajectory_for_robot(args, goals: bool = False) -> tuple[GaitSource, OnlineWalker, Trajectory]:
     """The walk the options ask for: (where its settings come from, its walker, its trajectory). A
     balanced walk's trajectory holds the planned angles, or with ``goals`` the angles its servos are sent
@@ -92,6 +105,9 @@ def trajectory_for_robot(args, goals: bool = False) -> tuple[GaitSource, OnlineW
     source = gait_source(args)
     if source.balanced:
         plan = build_balanced_walk(args, source)
+        note = speed_fit_note(plan)
+        if note:
+            print(f"note: {note}", file=sys.stderr)
         return source, plan, plan.walk.trajectory(goals=goals)
     source, walker = build_walk(args)
     return source, walker, trajectory_of(walker)

@@ -189,6 +189,11 @@ class BalancedWalker:
         self.finished = True
         self._commit()
 
+    @property
+    def rise_path(self) -> tuple[np.ndarray, np.ndarray]:
+        """(roots, angles) of the rise from straight legs that comes before the balance plan."""
+        return self._rise
+
     def straight_path(self, root_m, ankles, rising: bool) -> tuple[np.ndarray, np.ndarray]:
         """(roots (n, 3), angles (n, 12)) between straight legs over ``ankles`` (both feet flat, every joint
         0) and the pose whose root is ``root_m``: rising, from straight up to just before that pose;
@@ -447,7 +452,7 @@ def walk_of(walker: BalancedWalker) -> BalancedWalk:
         share = smoothed_share(a["share_left"], walker.rate_hz)
         goals = q + w * (whole.sag_goals(q, share, a["cops"], root, walker.kp_nm_per_rad) - q)
     # the rise from straight legs before the balance plan, and the way back down after it
-    rise_root, rise_q = walker._rise
+    rise_root, rise_q = walker.rise_path
     lower_root, lower_q = walker.straight_path(root[-1], a["ankles"][-1], rising=False)
     m = walker.rise_frames
 
