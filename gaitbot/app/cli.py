@@ -87,6 +87,8 @@ def _walk_inputs(p: argparse.ArgumentParser, demo: bool = False) -> None:
                    help="how high the whole swing sole stays above the ground while the foot moves forward, "
                    "metres (default: the robot's clearance_m)")
     p.add_argument("--rate", type=float, metavar="HZ", help="frame rate in Hz (default: the robot's rate_hz)")
+    p.add_argument("--cycle", type=float, metavar="S", help="walking cycle (two steps) in seconds "
+                   "(default: the robot's cycle_s)")
     p.add_argument("--terrain", metavar="FILE", help="walk a terrain course (TOML, see config/terrain/) instead of "
                    "--steps/--distance")
 
@@ -118,6 +120,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = parser.commands["generate"] = _command(sub, "generate")
     _walk_inputs(p)
     p.add_argument("-o", "--output", required=True, help="walk.csv or walk.npz (file formats: docs/file-formats.md)")
+    p.add_argument("--goals", action="store_true", help="write the goal angles a walk sends (servo-sag "
+                   "feedforward included) instead of the planned angles")
 
     p = parser.commands["plot"] = _command(sub, "plot")
     p.add_argument("file", help="trajectory (.csv or .npz), or an eigen-gait model (.npz from gaitbot eigen fit)")
@@ -139,10 +143,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--record", metavar="FILE", help="write every bus packet to this .jsonl file (gaitbot check reads it)")
     p.add_argument("--sim", action="store_true",
                    help="walk the simulated robot (MuJoCo) and measure whether it really walks")
-    p.add_argument("--free-pitch", action="store_true", help="--sim: let the torso pitch freely (default: held by a boom)")
     p.add_argument("--boom", action="store_true",
-                   help="the robot walks on a boom: accept a walk that would tip a free-standing robot")
-    p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (side view)")
+                   help="the robot walks on a boom: accept a walk that would tip a free-standing robot (with --sim: "
+                   "the simulated torso rides a boom, sliding forward and up, pitch held)")
+    p.add_argument("--free-pitch", action="store_true", help="--sim: the boom, with the torso free to pitch on it")
+    p.add_argument("--push", type=float, metavar="N_S", help="--sim: push the torso sideways with this impulse "
+                   "(N s, positive to the left) in the middle of a step half-way through the walk")
+    p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (three-quarter view)")
     p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
 
     p = parser.commands["check"] = _command(sub, "check")

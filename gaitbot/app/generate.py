@@ -1,4 +1,9 @@
-"""``gaitbot generate``: the trajectory of a walk, written as CSV or NPZ (docs/file-formats.md)."""
+"""``gaitbot generate``: the trajectory of a walk, written as CSV or NPZ (docs/file-formats.md).
+
+``--goals`` writes the goal angles a walk sends instead of the planned ones: for a balanced robot with
+servo-sag feedforward, each planned angle plus its gravity torque over the servo's stiffness (exactly
+what a dry-run recording of the same walk decodes to); for others the planned angles themselves.
+"""
 
 from __future__ import annotations
 
@@ -13,7 +18,7 @@ def run(args) -> int:
     if out.suffix not in (".csv", ".npz"):
         raise UsageError(f"-o {out}: the output must end in .csv or .npz")
     check_output_path(out)
-    source, walker, trajectory = trajectory_for_robot(args)
+    source, walker, trajectory = trajectory_for_robot(args, goals=getattr(args, "goals", False))
     write_output(out, trajectory.save)
     print(f"wrote {out} for {walked_by(source)}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
           f"{len(walker.heel_strikes)} heel strikes, {trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.4f} m")

@@ -122,6 +122,11 @@ def gait_source(args) -> GaitSource:
     if rate is not None:
         check_rate_range(rate)
     settings = walk_settings(robot, rate)
+    cycle = getattr(args, "cycle", None)
+    if cycle is not None and not (math.isfinite(cycle) and CYCLE_RANGE_S[0] <= cycle <= CYCLE_RANGE_S[1]):
+        raise UsageError(f"--cycle must be {CYCLE_RANGE_S[0]:g}..{CYCLE_RANGE_S[1]:g} seconds (two steps), got {cycle!r}")
+    if cycle is not None:
+        settings = WalkSettings(cycle, settings.rate_hz, settings.clearance)
     clearance = getattr(args, "clearance", None)
     if clearance is not None:
         if not (math.isfinite(clearance) and clearance >= 0):
@@ -129,12 +134,16 @@ def gait_source(args) -> GaitSource:
         settings = WalkSettings(settings.cycle_s, settings.rate_hz, clearance)
     reachable = make_context(geometry, settings).inverse.max_step_length
     max_step = robot.gait.max_step_m if robot_for_limits is not None else reachable
+    if robot_for_limits is not None and robot.is_3d:  # its max_step_m is the default; the leg's reach the limit
+        return GaitSource(geometry, settings, reachable, robot, default_step_m=min(max_step, reachable))
     return GaitSource(geometry, settings, min(max_step, reachable), robot_for_limits)
 
 
 #: The most steps one walk may have (planning costs about 5 ms a step), and the longest --distance.
 MAX_STEPS = 1000
 MAX_DISTANCE_M = 100.0
+#: --cycle (s): a walk cycle (two steps) shorter than a servo can follow or longer than any walk needs.
+CYCLE_RANGE_S = (0.2, 10.0)
 #: --seed must fit numpy's seeding (an unsigned 32-bit integer here).
 MAX_SEED = 2**32 - 1
 #: The longest wait for one status packet --reply-timeout-ms may set (start-up exchanges; a frame's
@@ -179,7 +188,8 @@ def step_lengths(args, source: GaitSource) -> list[float]:
             raise UsageError(f"--distance must be a positive number of metres, got {distance!r}")
         if distance > MAX_DISTANCE_M:
             raise UsageError(f"--distance {distance:g} m is longer than one walk may be (at most {MAX_DISTANCE_M:g} m)")
-        max_step = source.max_step_m if args.max_step is None else args.max_step
+        default = source.default_step_m if source.default_step_m is not None else source.max_step_m
+        max_step = default if args.max_step is None else args.max_step
         if not math.isfinite(max_step) or max_step <= 0:
             raise UsageError(f"--max-step must be a positive number of metres, got {max_step!r}")
         if max_step > source.max_step_m * (1 + 1e-12):
@@ -194,7 +204,8 @@ def step_lengths(args, source: GaitSource) -> list[float]:
         if value < 0:
             raise UsageError(f"--steps: step {i} is {value:g} m; step lengths must be 0 or more")
         if value > source.max_step_m * (1 + 1e-12):
-            what = "max_step_m in the robot config" if source.robot is not None else "the leg's reachable maximum"
+            what = ("max_step_m in the robot config" if source.robot is not None and not source.balanced
+                    else "the leg's reachable maximum")
             raise UsageError(f"--steps: step {i} is {value:g} m, longer than {source.max_step_m:.4g} m ({what})")
     sigma = getattr(args, "perturb", None)
     if sigma is not None and not (math.isfinite(sigma) and 0 <= sigma <= source.max_step_m):

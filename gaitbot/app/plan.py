@@ -15,14 +15,15 @@ def run(args) -> int:
     if getattr(args, "terrain", None) is not None:
         return _plan_terrain(args)
     source, walker, _ = trajectory_for_robot(args)
-    plan = plan_summary(source, walker)
+    plan = balanced_plan_summary(source, walker) if source.balanced else plan_summary(source, walker)
     if args.json:
         print(json.dumps(plan, indent=2))
         return 0
     print(f"{'step':>4} {'leg':>5} {'length m':>9} {'RV':>7} {'start s':>8} {'end s':>7} {'foothold m':>10}")
     for s in plan["steps"] + ([plan["closing_step"]] if plan["closing_step"] else []):
         label = "close" if s["closing"] else str(s["index"])
-        print(f"{label:>4} {s['leg']:>5} {s['length_m']:9.4f} {s['rv']:7.4f} {s['start_s']:8.3f} {s['end_s']:7.3f} "
+        rv = f"{s['rv']:7.4f}" if s["rv"] is not None else f"{'-':>7}"
+        print(f"{label:>4} {s['leg']:>5} {s['length_m']:9.4f} {rv} {s['start_s']:8.3f} {s['end_s']:7.3f} "
               f"{s['foothold_m']:10.4f}")
     print(f"{walked_by(source)}: {plan['n_steps']} steps, {plan['total_distance_m']:.4f} m in {plan['duration_s']:.2f} s "
           f"(cycle {plan['cycle_s']:.4f} s, {plan['rate_hz']:g} Hz, reachable step 0 to "
@@ -56,6 +57,39 @@ def _plan_terrain(args) -> int:
           f"{plan['cells_evaluated']} cells against {plan['cells_full_search']} for full searches. lift: how high "
           f"the swing foot is lifted above its path")
     return 0
+
+
+def balanced_plan_summary(source: GaitSource, plan) -> dict:
+    """A balanced walk's plan as a JSON-ready object: the same keys as plan_summary (RV is None: the
+    balanced walker has no Boulic RV), with the heel strikes' y and the settings it walks with."""
+    walk, fit = plan.walk, plan.fit
+    steps = [s.to_dict() for s in walk.planned_steps if not s.closing]
+    closing = [s.to_dict() for s in walk.planned_steps if s.closing]
+    timing = plan.walker.timing
+    return {
+        "robot": source.robot.name,
+        "walker": "balanced",
+        "leg_length_m": source.geometry.leg_length,
+        "cycle_s": timing.cycle_s,
+        "rate_hz": timing.rate_hz,
+        "reachable_step_m": [0.0, source.max_step_m],
+        "max_step_m": fit.gait.max_step_m,
+        "steps": steps,
+        "closing_step": closing[0] if closing else None,
+        "heel_strikes": [{"t_s": h.t_s, "leg": h.leg, "x_m": h.x_m, "y_m": h.y_m} for h in walk.heel_strikes],
+        "total_distance_m": walk.heel_strikes[-1].x_m if walk.heel_strikes else 0.0,
+        "n_steps": len(steps),
+        "duration_s": float(walk.t_s[-1]),
+        "n_frames": len(walk.t_s),
+        "crouch_knee_deg": fit.balance.crouch_knee_deg,
+        "double_support_share": fit.balance.double_support_share,
+        "progression_end": fit.balance.progression_end,
+        "clearance_m": fit.gait.clearance_m,
+        "peak_joint_speed_dps": fit.peak_dps,
+        "sag_feedforward": plan.walker.feedforward,
+        "com_height_m": plan.walker.com_height_m,
+        "preview_horizon_s": plan.walker.gains.horizon_frames / timing.rate_hz,
+    }
 
 
 def plan_summary(source: GaitSource, walker: OnlineWalker) -> dict:

@@ -6,6 +6,7 @@ bus behind the LimitGuard; docs/bus-faults.md says what happens when the bus fai
 
 from __future__ import annotations
 
+import math
 import sys
 
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
@@ -67,8 +68,9 @@ def run(args) -> int:
     config = load_robot(args.robot, getattr(args, "calibration", None))
     check_rate_option(config, args.rate)
     args.robot = str(config.path)
-    source, walker, trajectory = trajectory_for_robot(args)
-    report = preflight(config, trajectory, on_boom=args.boom)
+    source, walker, trajectory = trajectory_for_robot(args, goals=True)  # what the servos are sent
+    planned = walker.walk.trajectory() if hasattr(walker, "walk") else trajectory  # what the body does
+    report = preflight(config, trajectory, on_boom=args.boom, planned=planned)
     if not report.ok:
         raise LimitBroken(f"walk refused before anything moved: {report.first_error}")
     frames = trajectory_ticks(config, trajectory)
@@ -80,7 +82,8 @@ def run(args) -> int:
     if args.sim:
         from gaitbot.sim.walk import SimWalk, walk_plan  # MuJoCo: only with --sim
 
-        sim = SimWalk(config, source.settings.rate_hz, walk_plan(walker, trajectory), args.free_pitch, args.video)
+        sim = SimWalk(config, source.settings.rate_hz, walk_plan(walker, planned), sim_support(args, config),
+                      args.video, args.push)
     hardware = not (args.dry_run or args.sim)
     port = serial_port(config, args.port, dry_run=not hardware)
     clock = MonotonicClock() if (hardware or args.realtime) else VirtualClock()
@@ -125,8 +128,10 @@ def run(args) -> int:
     if sim is not None and args.json:
         return _sim_exit(_sim_report(sim, True, result.outcome, args.video), result.exit_code)
     if sim is not None:
+        torso = {"free": "free-floating torso", "boom": "torso on a boom, pitch held",
+                 "boom-pitch": "torso on a boom, free to pitch"}[sim.robot.support]
         mode = (f"simulated robot (MuJoCo; {config.bus.backend} packets on a simulated bus, simulated clock; "
-                f"torso {'free to pitch' if args.free_pitch else 'on a boom, pitch held'})")
+                f"{torso})")
     elif not args.dry_run:
         mode = f"{config.bus.backend} on {port}"
     elif args.realtime:
@@ -144,7 +149,10 @@ def run(args) -> int:
     if args.record:
         print(f"recording: {args.record}")
     if sim is not None:
-        return _sim_exit(_sim_report(sim, False, result.outcome, args.video), result.exit_code)
+        report = _sim_report(sim, False, result.outcome, args.video)
+        if report.fell:
+            print(f"The robot fell {report.fall_direction} at {report.fell_at_s:.2f} s ({report.fall_reason}).")
+        return _sim_exit(report, result.exit_code)
     return result.exit_code
 
 
@@ -158,11 +166,23 @@ def _sim_exit(report, session_exit: int) -> int:
     return 1 if report.fell and session_exit == 0 else session_exit
 
 
+def sim_support(args, config) -> str:
+    """How the simulated torso is held: free-floating unless --boom or --free-pitch asks for the boom (or the
+    config says the robot walks on one, ``[robot] boom = true``)."""
+    if args.free_pitch:
+        return "boom-pitch"
+    return "boom" if (args.boom or config.boom) else "free"
+
+
+MAX_PUSH_NS = 20.0
+"""The largest --push (N s): far beyond what knocks over any small humanoid (docs/simulation.md)."""
+
+
 def check_sim_arguments(args) -> None:
     """Refuse what a simulated walk cannot honour, and a missing MuJoCo, before any work is done."""
     sim = getattr(args, "sim", False)
     if not sim:
-        for flag in ("free_pitch", "video", "json"):
+        for flag in ("free_pitch", "push", "video", "json"):
             if getattr(args, flag, None):
                 raise UsageError(f"--{flag.replace('_', '-')}: only with --sim (a simulated walk)")
         return
@@ -177,6 +197,13 @@ def check_sim_arguments(args) -> None:
     for flag, why in refused.items():
         if getattr(args, flag, None):
             raise UsageError(f"--{flag.replace('_', '-')}: {why}")
+    push = getattr(args, "push", None)
+    if push is not None:
+        if not (math.isfinite(push) and push != 0 and abs(push) <= MAX_PUSH_NS):
+            raise UsageError(f"--push must be a non-zero impulse of at most {MAX_PUSH_NS:g} N s (positive to the left), "
+                             f"got {push!r}")
+        if getattr(args, "boom", False) or getattr(args, "free_pitch", False):
+            raise UsageError("--push: a sideways push needs a free-floating torso (the boom holds it sideways)")
     import_mujoco()
     if getattr(args, "video", None):
         check_video_path(args.video)

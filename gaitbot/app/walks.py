@@ -3,6 +3,7 @@ plan and a trajectory, for ``plan``, ``generate`` and ``walk``."""
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from gaitbot.gait.terrain.footholds import CourseError
 from gaitbot.gait.terrain.walk import plan_terrain_walk
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.gait.walker import OnlineWalker, WalkSettings, make_context, plan_walk, trajectory_of
+from gaitbot.robot.balanced_walk import BalancedPlan, balanced_gait_settings, plan_balanced
 from gaitbot.robot.walk_settings import GaitSource, terrain_settings
 
 
@@ -79,12 +81,48 @@ def trajectory_file_walk(args) -> tuple[GaitSource, FileWalk, Trajectory]:
     return GaitSource(source.geometry, settings, source.max_step_m, source.robot), FileWalk(strikes), trajectory
 
 
-def trajectory_for_robot(args) -> tuple[GaitSource, OnlineWalker, Trajectory]:
+def build_balanced_walk(args, source: GaitSource) -> BalancedPlan:
+    """The balanced walk of a robot whose legs roll: its steps, with --cycle, --rate, --max-step and
+    --clearance over the config's [gait]; the servos' speed fitted (gaitbot.gait.balance.speed_fit)."""
+    steps = step_lengths(args, source)
+    longest = max([args.max_step or source.default_step_m or 0.0, *steps])
+    gait = balanced_gait_settings(source.robot, cycle_s=source.settings.cycle_s, rate_hz=source.settings.rate_hz,
+                                  max_step_m=longest, clearance_m=source.settings.clearance)
+    return plan_balanced(source.robot, steps, gait)
+
+
+def speed_fit_note(walker) -> str | None:
+    """One line when a balanced walk's settings were relaxed to fit the servos' speed (else None)."""
+    fit = getattr(walker, "fit", None)
+    if fit is None or fit.relaxed == 0:
+        return None
+    b, g = fit.balance, fit.gait
+    return (f"the servos' max_velocity_dps ({fit.limit_dps:g}) needed a gentler walk at this cycle and step: crouch "
+            f"{b.crouch_knee_deg:g} deg, double support {100 * b.double_support_share:g}%, progression done at "
+            f"{100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm (peak "
+            f"{fit.peak_dps:.0f} deg/s; docs/balance.md)")
+
+
+def trajectory_for_robot(args, goals: bool = False) -> tuple[GaitSource, OnlineWalker, Trajectory]:
+    """The walk the options ask for: (where its settings come from, its walker, its trajectory). A
+    balanced walk's trajectory holds the planned angles, or with ``goals`` the angles its servos are sent
+    (servo-sag feedforward included); a planar walk's are the same."""
     if getattr(args, "trajectory", None) is not None:
         return trajectory_file_walk(args)
     if getattr(args, "terrain", None) is not None:
+        source = gait_source(args)
+        if source.balanced:
+            raise UsageError(f"--terrain: robot {source.robot.name} walks with the balanced walker, which walks "
+                             "on the flat only (terrain courses are walked by the planar walker)")
         source, walk = build_terrain_walk(args)
         return source, walk, pelvis_root(source, walk.trajectory)
+    source = gait_source(args)
+    if source.balanced:
+        plan = build_balanced_walk(args, source)
+        note = speed_fit_note(plan)
+        if note:
+            print(f"note: {note}", file=sys.stderr)
+        return source, plan, plan.walk.trajectory(goals=goals)
     source, walker = build_walk(args)
     return source, walker, pelvis_root(source, trajectory_of(walker))
 

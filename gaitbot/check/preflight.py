@@ -31,14 +31,19 @@ def robot_angles_deg(config: RobotConfig, trajectory: Trajectory):
 
 
 def preflight(config: RobotConfig, trajectory: Trajectory, margin_deg: float = 0.0, *,
-              on_boom: bool = False) -> CheckReport:
-    """Every frame of ``trajectory`` against ``config``'s limits (held joints at their hold angles) and,
-    unless the robot walks on a boom (``on_boom`` or ``[robot] boom``), against tipping over."""
+              on_boom: bool = False, planned: Trajectory | None = None) -> CheckReport:
+    """Every frame of ``trajectory`` (what the servos are sent) against ``config``'s limits (held joints at
+    their hold angles) and, unless the robot walks on a boom (``on_boom`` or ``[robot] boom``), the body's
+    motion against tipping over: ``planned`` if given, else ``trajectory``. The two differ when a
+    balanced walk's goals carry the servo-sag feedforward: the goals overshoot by the sag the loaded servos
+    will have (docs/balance.md), so the body follows the planned angles, not the goals."""
     angles = robot_angles_deg(config, trajectory)
     report = check_trajectory(config, trajectory.t_s, angles, margin_deg)
     if on_boom or config.boom:
         why = "[robot] boom = true" if config.boom else "--boom"
         return replace(report, balance=BalanceSummary(False, f"{config.name} walks on a boom: {why}"))
+    if planned is not None:
+        trajectory, angles = planned, robot_angles_deg(config, planned)
     trace = balance_trace(config, trajectory, angles)
     outside = trace.margin_m < 0
     found = _balance_episodes(trace, outside) + _sinking_episodes(trace)

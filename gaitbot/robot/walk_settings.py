@@ -32,12 +32,20 @@ class GaitSource:
     """Where a walk's geometry and settings come from, and the longest step allowed (metres).
 
     ``robot`` is None when the leg is not the configured robot's (a leg given on the command line),
-    whose joint limits then do not apply."""
+    whose joint limits then do not apply. ``default_step_m``: the longest step of ``--distance`` when
+    ``--max-step`` is not given, if not ``max_step_m`` (a balanced robot's ``[gait] max_step_m`` is its
+    default, and its reach the limit)."""
 
     geometry: LegGeometry
     settings: WalkSettings
     max_step_m: float
     robot: RobotConfig | None
+    default_step_m: float | None = None
+
+    @property
+    def balanced(self) -> bool:
+        """The robot's legs roll: it walks with the balanced walker (gaitbot.robot.balanced_walk)."""
+        return self.robot is not None and self.robot.is_3d
 
 
 def joint_limits_ticks(config: RobotConfig) -> tuple[float, float]:

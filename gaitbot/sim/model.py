@@ -87,12 +87,13 @@ class JointDrive:
         return self.damping_nm_s_per_rad * MOTOR_TIME_CONSTANT_S
 
 
-def joint_drives(config: RobotConfig) -> tuple[JointDrive, ...]:
-    """The six walking joints' drives: each joint's servo model at its factory gain, with the ``[servo]``
-    stall torque and no-load speed overrides applied (the gain is the control table's business)."""
+def joint_drives(config: RobotConfig, joints=None) -> tuple[JointDrive, ...]:
+    """The walking joints' drives (or those of ``joints``): each joint's servo model at its factory gain,
+    with the ``[servo]`` stall torque and no-load speed overrides applied (the gain is the control table's
+    business)."""
     over = config.servo
     drives = []
-    for joint in config.walking_joints:
+    for joint in (config.walking_joints if joints is None else joints):
         model = joint.model
         rpm = over.no_load_speed_rpm if over.no_load_speed_rpm is not None else model.no_load_speed_rpm
         drives.append(JointDrive(

@@ -17,25 +17,42 @@ import numpy as np
 
 from gaitbot.sim import import_mujoco
 from gaitbot.sim.model import SIDES, build_mjcf, joint_drives, substeps_per_frame
+from gaitbot.sim.model3d import SUPPORTS, build_mjcf_3d
 from gaitbot.robot.config import RobotConfig
 
 
 class SimRobot:
     """The MuJoCo model of ``config``, standing straight at t = 0 with its servos limp.
 
-    Walking joints are indexed 0..5 in the config's (PITCH_JOINTS) order everywhere here.
+    ``support``: "free" (a free-floating torso: the 3D model of gaitbot.sim.model3d), "boom" or
+    "boom-pitch" (the torso on a boom, its pitch held or free; None: "boom-pitch" if ``free_pitch`` else
+    "boom"). A pitch-only robot on the boom is today's planar model (gaitbot.sim.model), so its figures
+    stay what they were; every other case is the 3D model with every joint of the config.
+    The modelled joints (``joint_names``: the walking joints, then in the 3D model the held ones) are
+    indexed in that order everywhere here.
     ``effort_peak``: per servo, the largest |commanded torque| / stall torque since the observers
     last reset it (1.0 = saturated); ``touch_steps``: per sole (left, right), timesteps in contact;
     ``full_torque_error_deg``: per servo, its stiffness now (factory until a gain is written).
     """
 
-    def __init__(self, config: RobotConfig, rate_hz: float, free_pitch: bool = False) -> None:
+    def __init__(self, config: RobotConfig, rate_hz: float, free_pitch: bool = False, support: str | None = None) -> None:
         self.mujoco = mujoco = import_mujoco()
         self.config = config
-        self.free_pitch = free_pitch
-        self.model = mujoco.MjModel.from_xml_string(build_mjcf(config, rate_hz, free_pitch))
+        support = support or ("boom-pitch" if free_pitch else "boom")
+        if support not in SUPPORTS:
+            raise ValueError(f"support must be one of {SUPPORTS}, got {support!r}")
+        self.support = support
+        self.free_pitch = support == "boom-pitch"
+        self.planar = support != "free" and not config.is_3d
+        if self.planar:
+            self.drives = joint_drives(config)
+            xml = build_mjcf(config, rate_hz, self.free_pitch)
+        else:
+            self.drives = joint_drives(config, config.joints)
+            xml = build_mjcf_3d(config, self.drives, rate_hz, support)
+        self.model = mujoco.MjModel.from_xml_string(xml)
         self.data = mujoco.MjData(self.model)
-        self.drives = joint_drives(config)
+        self.joint_names = tuple(d.name for d in self.drives)
         self.substeps = substeps_per_frame(rate_hz)
         self.frame_s = 1.0 / rate_hz
         self.timestep_s = float(self.model.opt.timestep)
@@ -100,11 +117,48 @@ class SimRobot:
         """(x, z) of the hip point (the torso body's origin) in the world."""
         return self.data.xpos[self.torso_body][[0, 2]].copy()
 
+    def torso_xyz_m(self) -> np.ndarray:
+        """The root (the torso body's origin) in the world."""
+        return self.data.xpos[self.torso_body].copy()
+
+    def torso_rpy_rad(self) -> np.ndarray:
+        """The torso's roll, pitch (forward lean positive) and yaw (Z-Y-X angles of its rotation)."""
+        if self.planar:
+            return np.array([0.0, self.torso_pitch_rad(), 0.0])
+        r = self.data.xmat[self.torso_body].reshape(3, 3)
+        return np.array([math.atan2(r[2, 1], r[2, 2]), math.asin(-max(-1.0, min(1.0, r[2, 0]))),
+                         math.atan2(r[1, 0], r[0, 0])])
+
     def torso_pitch_rad(self) -> float:
         """Forward lean of the torso (0 when held)."""
+        if self.support == "free":
+            return float(self.torso_rpy_rad()[1])
         if not self.free_pitch:
             return 0.0
         return float(self.data.qpos[self.model.joint("boom_pitch").qposadr[0]])
+
+    def place(self, angles_rad: dict[str, float], root_m) -> None:
+        """Put the robot in a pose before anything moves: joint angles by name, the root at ``root_m``
+        (x, y, z; on the boom only x and z count). Velocities zero; the servos' goals follow."""
+        data, model = self.data, self.model
+        for i, name in enumerate(self.joint_names):
+            if name in angles_rad:
+                data.qpos[self.qpos_index[i]] = angles_rad[name]
+                data.ctrl[self.actuator_index[i]] = angles_rad[name]
+        root = np.asarray(root_m, dtype=float)
+        if self.support == "free":
+            data.qpos[:3] = root
+            data.qpos[3:7] = (1.0, 0.0, 0.0, 0.0)
+        else:
+            standing = model.body_pos[self.torso_body]
+            data.qpos[model.joint("boom_x").qposadr[0]] = root[0] - standing[0]
+            data.qpos[model.joint("boom_z").qposadr[0]] = root[2] - standing[2]
+        data.qvel[:] = 0.0
+        self.mujoco.mj_forward(model, data)
+
+    def push(self, force_y_n: float) -> None:
+        """A sideways force on the torso's centre of mass (N, positive to the left) until changed."""
+        self.data.xfrc_applied[self.torso_body, 1] = force_y_n
 
     def advance_to(self, t_s: float) -> None:
         """Step the physics to the whole timestep nearest ``t_s``; call the observers at each frame end."""

@@ -14,8 +14,8 @@ servos would) with physics behind the control tables instead of ideal servos:
   table starts with the factory value, so a session that writes no gain walks at factory stiffness;
 * a present-position read answers the simulated joint angle (angle -> ticks by the calibration).
 
-Joints the model does not have (held joints such as the ax12a-biped's hip roll) stay ideal mock
-servos. Everything else (pings, checksums, status packets, the recorder) is the mock's, so a
+Joints the model does not have (held joints such as the ax12a-biped's hip roll on the planar boom
+model) stay ideal mock servos. Everything else (pings, checksums, status packets, the recorder) is the mock's, so a
 ``--sim --record`` recording holds exactly the packets a real run would send.
 """
 
@@ -43,7 +43,7 @@ class SimPort(MockPort):
                          baudrate=config.bus.baudrate)
         self.robot = robot
         self.now = now
-        walking = config.walking_joints
+        walking = [config.joint(name) for name in robot.joint_names]  # the joints the model has, in its order
         self.joint_of = {j.id: i for i, j in enumerate(walking)}
         self._ids = [j.id for j in walking]
         self._calibration = {j.id: (j.zero_tick, j.direction, j.model.ticks_per_rad) for j in walking}

@@ -1,7 +1,8 @@
-"""A side view of the simulated walk, rendered offscreen, written as GIF (Pillow) or MP4 (imageio-ffmpeg).
+"""A three-quarter view of the simulated walk, rendered offscreen, written as GIF (Pillow) or MP4 (imageio-ffmpeg).
 
-The camera looks at the robot from its right side (along +y; forward is to the right of the
-picture) and follows the hip; the near (right) leg is orange, the far (left) one grey. The planned heel strikes are drawn
+The camera looks at the robot from ahead of its right side and a little above (azimuth 120 deg,
+elevation -20 deg), so the legs' roll and the weight shift show as well as the steps, and follows the
+root; the near (right) leg is orange, the far (left) one grey. The planned heel strikes are drawn
 on the floor as thin bars under each foot's track (green: left, red: right), so a foot landing
 short or long shows. Rendering uses MuJoCo's offscreen
 context: EGL by default (MUJOCO_GL=osmesa for pure software rendering).
@@ -37,14 +38,16 @@ def check_video_path(path: str | Path) -> Path:
 class VideoRecorder:
     """An observer of a SimRobot that renders a frame every 1/fps simulated seconds while torque is on.
 
-    footholds: planned heel strikes as (leg, heel x in the simulation's world, metres)."""
+    footholds: planned heel strikes as (leg, heel x in the plan's world, metres); x_origin_m: the plan's x
+    at the simulated world's origin."""
 
-    def __init__(self, robot: SimRobot, path: str | Path, footholds: tuple[tuple[str, float], ...] = ()) -> None:
+    def __init__(self, robot: SimRobot, path: str | Path, footholds: tuple[tuple[str, float], ...] = (),
+                 x_origin_m: float = 0.0) -> None:
         self.path = check_video_path(path)
         suffix = self.path.suffix.lower()
         self.fps = FORMATS[suffix]
         self.width, self.height = SIZE[suffix]
-        self.footholds = footholds
+        self.footholds = tuple((leg, x - x_origin_m) for leg, x in footholds)
         self.frames: list[np.ndarray] = []
         self._next_s = 0.0
         mujoco = robot.mujoco
@@ -55,9 +58,10 @@ class VideoRecorder:
                              f"try MUJOCO_GL=osmesa or MUJOCO_GL=egl") from None
         self.camera = mujoco.MjvCamera()
         self.camera.type = mujoco.mjtCamera.mjCAMERA_FREE
-        self.camera.azimuth, self.camera.elevation = 90.0, -8.0
+        # three-quarter view: from the robot's front right, a little above (forward is to the picture's right)
+        self.camera.azimuth, self.camera.elevation = 120.0, -20.0
         leg = robot.config.geometry.thigh_m + robot.config.geometry.shank_m
-        self.camera.distance = 3.2 * leg
+        self.camera.distance = 3.6 * leg
         self._marker_size = np.array([0.003, 0.35 * robot.config.geometry.hip_width_m, 0.0005])
         self._marker_y = {"left": robot.config.geometry.hip_width_m / 2, "right": -robot.config.geometry.hip_width_m / 2}
 
@@ -65,8 +69,8 @@ class VideoRecorder:
         if not robot.torque_on.all() or robot.time_s + 1e-9 < self._next_s:
             return
         self._next_s += 1.0 / self.fps
-        hip = robot.torso_position_m()
-        self.camera.lookat[:] = (hip[0], 0.0, 0.55 * hip[1])
+        root = robot.torso_xyz_m()
+        self.camera.lookat[:] = (root[0], root[1], 0.55 * root[2])
         self.renderer.update_scene(robot.data, self.camera)
         flags, names = self.renderer.scene.flags, robot.mujoco.mjtRndFlag
         flags[names.mjRND_SHADOW] = flags[names.mjRND_REFLECTION] = False  # shadows: 10x the rest in software GL

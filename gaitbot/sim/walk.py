@@ -1,66 +1,134 @@
 """A walk on the simulated robot, and what the plan promised it (``gaitbot walk --sim``).
 
-The physics, the port and the meter (model.py, physics.py, port.py, metrics.py) know nothing of the
-gait: the planned distance, the swing windows and the footholds are taken from the walker here and
-handed down as a WalkPlan. The walk itself runs exactly as ``gaitbot walk`` runs it (preflight,
-LimitGuard, walk_session, --record); only the bus is the simulated robot's and the clock virtual.
+The physics, the port and the meter (model.py, model3d.py, physics.py, port.py, metrics.py) know nothing
+of the gait: the planned distance, the swing windows, the heel strikes and the first pose are taken
+from the walker here and handed down as a WalkPlan. The walk itself runs exactly as ``gaitbot walk``
+runs it (preflight, LimitGuard, walk_session, --record); only the bus is the simulated robot's and the
+clock virtual. ``--push`` is a Pusher observer: a sideways force on the torso for PUSH_DURATION_S,
+starting in the middle of the swing of the step half-way through the walk.
 """
 
 from __future__ import annotations
 
 import json
 import sys
-
 from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
 
 from gaitbot.bus.base import Bus
 from gaitbot.bus.log import BusRecorder
 from gaitbot.gait.segments import CLEARANCE_WINDOW
 from gaitbot.gait.trajectory import Trajectory
-from gaitbot.gait.walker import OnlineWalker
 from gaitbot.robot.config import RobotConfig
-from gaitbot.sim.metrics import SimReport, SwingWindow, WalkMeter, WalkPlan
+from gaitbot.sim.metrics import PlannedStrike, SimReport, SwingWindow, WalkMeter, WalkPlan
+
+PUSH_DURATION_S = 0.1
 
 
-def swing_windows(walker: OnlineWalker) -> tuple[SwingWindow, ...]:
+def swing_windows(walker) -> tuple[SwingWindow, ...]:
     """For every planned step: the swinging leg over the part of its swing where the gait keeps the
-    sole the configured clearance above the floor (CLEARANCE_WINDOW of the time from toe-off, at
-    toe_off_u of the step, to heel strike)."""
-    ctx = walker.ctx
+    sole the configured clearance above the floor (CLEARANCE_WINDOW of the time from toe-off to heel
+    strike). Planar walker: toe-off at toe_off_u of the step; balanced walker: at the end of double support."""
     windows = []
-    for step in walker.planned_steps:
-        toe_off_s = step.start_s + ctx.toe_off_u * (step.end_s - step.start_s)
-        span = step.end_s - toe_off_s
-        windows.append(SwingWindow(step.leg, toe_off_s + CLEARANCE_WINDOW[0] * span,
-                                   toe_off_s + CLEARANCE_WINDOW[1] * span))
+    if hasattr(walker, "ctx"):
+        for step in walker.planned_steps:
+            toe_off_s = step.start_s + walker.ctx.toe_off_u * (step.end_s - step.start_s)
+            span = step.end_s - toe_off_s
+            windows.append(SwingWindow(step.leg, toe_off_s + CLEARANCE_WINDOW[0] * span,
+                                       toe_off_s + CLEARANCE_WINDOW[1] * span))
+        return tuple(windows)
+    swinging, rate = walker.walk.swinging, 1.0 / (walker.walk.t_s[1] - walker.walk.t_s[0])
+    edges = np.flatnonzero(np.diff(np.r_[0, swinging, 0]))
+    for start, end in zip(edges[:-1], edges[1:]):
+        if swinging[start]:
+            # frame k holds the pose at k / rate: the swing spans (start - 1, end - 1] / rate
+            begin, finish = (start - 1) / rate, (end - 1) / rate
+            span = finish - begin
+            leg = "left" if swinging[start] == 1 else "right"
+            windows.append(SwingWindow(leg, begin + CLEARANCE_WINDOW[0] * span, begin + CLEARANCE_WINDOW[1] * span))
     return tuple(windows)
 
 
-def walk_plan(walker: OnlineWalker, trajectory: Trajectory) -> WalkPlan:
-    """The plan in the simulation's terms: hip displacement, swing windows, and the heel strikes
-    in the simulated world, whose x origin is the hip's starting point."""
-    origin = float(trajectory.root_m[0, 0])
-    return WalkPlan(distance_m=float(trajectory.root_m[-1, 0]) - origin, swings=swing_windows(walker),
-                    footholds=tuple((h.leg, float(h.x_m) - origin) for h in walker.heel_strikes))
+def walk_plan(walker, trajectory: Trajectory) -> WalkPlan:
+    """The plan in the simulation's terms, in the plan's world, with the walk's first pose."""
+    strikes = tuple(PlannedStrike(h.t_s, h.leg, float(h.x_m), h.y_m) for h in walker.heel_strikes)
+    return WalkPlan(distance_m=float(trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]),
+                    swings=swing_windows(walker), footholds=tuple((h.leg, float(h.x_m)) for h in walker.heel_strikes),
+                    heel_strikes=strikes, lateral_m=float(trajectory.root_m[-1, 1] - trajectory.root_m[0, 1]),
+                    start_angles_rad=dict(zip(trajectory.joints, (float(a) for a in trajectory.angles_rad[0]))),
+                    start_root_m=tuple(float(v) for v in trajectory.root_m[0]))
+
+
+@dataclass(frozen=True)
+class Push:
+    """A sideways impulse (N s, positive to the left) from start_s, in the swing of step ``step``."""
+
+    impulse_n_s: float
+    start_s: float
+    step: int
+    leg: str
+
+    @property
+    def end_s(self) -> float:
+        return self.start_s + PUSH_DURATION_S
+
+    def to_dict(self) -> dict:
+        return {"impulse_n_s": self.impulse_n_s, "start_s": self.start_s, "end_s": self.end_s, "step": self.step,
+                "leg": self.leg}
+
+
+def mid_walk_push(plan: WalkPlan, impulse_n_s: float) -> Push:
+    """The push of ``--push``: at the middle of the swing of the step half-way through the walk."""
+    if not plan.swings:
+        raise ValueError("the walk has no steps to push in")
+    index = len(plan.swings) // 2
+    window = plan.swings[index]
+    return Push(impulse_n_s, 0.5 * (window.start_s + window.end_s), index + 1, window.leg)
+
+
+class Pusher:
+    """An observer that applies a Push: the force is set at frame ends, so it acts on whole frames."""
+
+    def __init__(self, push: Push, frame_s: float) -> None:
+        self.push = push
+        frames = max(1, round(PUSH_DURATION_S / frame_s))
+        self.force_n = push.impulse_n_s / (frames * frame_s)
+        self.frames_left = frames
+
+    def __call__(self, robot) -> None:
+        on = self.frames_left > 0 and robot.time_s + 1e-9 >= self.push.start_s
+        if on:
+            self.frames_left -= 1
+        robot.push(self.force_n if on else 0.0)
 
 
 class SimWalk:
-    """The simulated robot of one walk, its measurements and, if asked, its video."""
+    """The simulated robot of one walk, its measurements and, if asked, its video and push."""
 
-    def __init__(self, config: RobotConfig, rate_hz: float, plan: WalkPlan, free_pitch: bool = False,
-                 video: str | None = None) -> None:
+    def __init__(self, config: RobotConfig, rate_hz: float, plan: WalkPlan, support: str = "free",
+                 video: str | None = None, push_n_s: float | None = None) -> None:
         from gaitbot.sim.physics import SimRobot
 
         self.config = config
         self.plan = plan
-        self.robot = SimRobot(config, rate_hz, free_pitch)
-        self.meter = WalkMeter(self.robot)
+        self.robot = SimRobot(config, rate_hz, support=support)
+        if self.robot.planar:  # today's planar model starts standing straight, its hip at x = 0
+            self.plan = plan = replace(plan, x_origin_m=plan.start_root_m[0] if plan.start_root_m else 0.0)
+        elif plan.start_angles_rad is not None:  # the 3D model stands in the walk's first pose, in its world
+            self.robot.place(plan.start_angles_rad, plan.start_root_m)
+        self.meter = WalkMeter(self.robot, plan)
         self.robot.observers.append(self.meter)
+        self.push = None
+        if push_n_s:
+            self.push = mid_walk_push(plan, push_n_s)
+            self.robot.observers.append(Pusher(self.push, self.robot.frame_s))
         self.video = None
         if video:
             from gaitbot.sim.video import VideoRecorder
 
-            self.video = VideoRecorder(self.robot, video, plan.footholds)
+            self.video = VideoRecorder(self.robot, video, plan.footholds, plan.x_origin_m)
             self.robot.observers.append(self.video)
 
     def make_bus(self, now: Callable[[], float], recorder: BusRecorder | None) -> Bus:
@@ -70,7 +138,8 @@ class SimWalk:
         return make_sim_bus(self.config, self.robot, now, recorder)
 
     def report(self) -> SimReport:
-        return self.meter.report(self.plan, self.robot.free_pitch)
+        return self.meter.report(self.plan, self.robot.free_pitch,
+                                 self.push.to_dict() if self.push is not None else None)
 
     def print_report(self, as_json: bool, outcome: str, on_progress=None) -> SimReport:
         """The measurements: a summary paragraph, or (``as_json``) one JSON object on stdout; returned too.

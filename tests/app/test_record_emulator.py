@@ -136,7 +136,7 @@ def start_record(config_name: str, port: str, out: Path, *extra: str) -> subproc
 def wait_for_rows(path: Path, rows: int, process: subprocess.Popen, timeout_s: float = 30.0) -> None:
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
-        if path.exists() and len(path.read_text().splitlines()) > rows:
+        if path.exists() and len(path.read_text().splitlines()) >= rows + 2:  # the version line and the header
             return
         if process.poll() is not None:
             raise AssertionError(f"recording ended early: {process.communicate()}")

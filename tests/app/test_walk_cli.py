@@ -50,7 +50,8 @@ def test_dry_run_recording_matches_generate(config_path, tmp_path, capsys):
     config = load_robot_config(config_path)
     record, csv = tmp_path / "run.jsonl", tmp_path / "walk.csv"
     assert main(["walk", "--robot", str(config_path), "--distance", "1.0", "--dry-run", "--record", str(record)]) == 0
-    assert main(["generate", "--robot", str(config_path), "--distance", "1.0", "-o", str(csv)]) == 0
+    # the goals a walk sends: the planned angles, plus the servo-sag feedforward on balanced robots
+    assert main(["generate", "--robot", str(config_path), "--distance", "1.0", "--goals", "-o", str(csv)]) == 0
     model = config.joints[0].model
     protocol = config.bus.protocol if config.bus.backend == "dynamixel" else 1.0
     header, times, frames = goal_frames(record, protocol, model.len_goal_position, model.byte_order == "big")

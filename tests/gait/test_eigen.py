@@ -438,7 +438,7 @@ def test_cli_malformed_and_unusable_examples_exit_2(files, tmp_path, capsys):
     model = str(tmp_path / "m.npz")
     standing = tmp_path / "standing.csv"
     tr = walk(0.05)
-    Trajectory(tr.t_s[:200], np.zeros((200, 6)), np.tile([0.0, 0.25], (200, 1))).save(standing)
+    Trajectory.sagittal(tr.t_s[:200], np.zeros((200, 6)), np.tile([0.0, 0.25], (200, 1))).save(standing)
     assert main(["eigen", "fit", str(standing), paths[0], "-o", model]) == 2
     one_line_error(capsys, "standing.csv", "no complete steady cycle")
     truncated = tmp_path / "cut.npz"

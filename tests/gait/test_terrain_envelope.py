@@ -11,7 +11,8 @@ from gaitbot.robot.config import ConfigError, load_robot_config
 from helpers import REPO_ROOT
 
 ROOT = REPO_ROOT
-ROBOTS = sorted((ROOT / "config").glob("*.toml"))
+# Terrain is walked by the planar walker: every shipped pitch-only robot states its step envelope.
+ROBOTS = sorted(p for p in (ROOT / "config").glob("*.toml") if not load_robot_config(p).is_3d)
 ENV = StepEnvelope.for_foot(0.12, 0.04, 0.035, 0.08, "test leg")
 
 

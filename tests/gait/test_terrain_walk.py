@@ -24,7 +24,8 @@ from helpers import REPO_ROOT, fk_foot, height, surface_pieces, swing_clearances
 
 ROOT = REPO_ROOT
 EXAMPLES = ROOT / "config" / "terrain"
-ROBOTS = sorted(p.stem for p in (ROOT / "config").glob("*.toml"))
+# Terrain is walked by the planar walker: every shipped robot that gives its step envelope ([terrain]).
+ROBOTS = sorted(p.stem for p in (ROOT / "config").glob("*.toml") if load_robot_config(p).terrain is not None)
 TOUCH = 1e-9  # a point this close to the terrain in two consecutive frames is a locked contact
 MARGIN = 0.01
 LIFT_OFF_SHARE = 0.05  # the most of a swing's time its sole may stay within 0.2 mm of the ground at lift-off

@@ -103,7 +103,7 @@ def recorded_packets(path) -> list[tuple[float, str]]:
 @pytest.mark.parametrize("name", ROBOTS)
 def test_a_sim_recording_sends_what_a_dry_run_sends_and_passes_gaitbot_check(name, tmp_path, capsys):
     sim, dry = tmp_path / "sim.jsonl", tmp_path / "dry.jsonl"
-    assert main(["walk", "--robot", name, "--steps", "0.03,0.03", "--sim", "--record", str(sim)]) == 0
+    assert main(["walk", "--robot", name, "--steps", "0.03,0.03", "--sim", "--boom", "--record", str(sim)]) == 0
     assert main(["walk", "--robot", name, "--steps", "0.03,0.03", "--dry-run", "--record", str(dry)]) == 0
     assert recorded_packets(sim) == recorded_packets(dry)
     capsys.readouterr()

@@ -86,7 +86,7 @@ def test_an_sts3215_follows_its_p_coefficient():
 
 def sim_json(capsys, *args: str) -> dict:
     capsys.readouterr()
-    assert main(["walk", "--sim", "--json", *args]) == 0
+    assert main(["walk", "--sim", "--boom", "--json", *args]) == 0
     return json.loads(capsys.readouterr().out)
 
 

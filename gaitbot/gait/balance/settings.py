@@ -26,11 +26,11 @@ class BalanceSettings:
     crouch_knee_deg: float = 60.0
     double_support_share: float = 0.15
     zmp_forward_m: float = 0.025
-    zmp_inward_m: float = 0.01
+    zmp_inward_m: float = 0.0
     preview_horizon_s: float = 1.0
     preview_jerk_weight: float = 1e-6
     sag_feedforward: bool = True
-    progression_end: float = 0.8
+    progression_end: float = 0.85
 
     def __post_init__(self) -> None:
         for name, (lo, hi) in LIMITS.items():

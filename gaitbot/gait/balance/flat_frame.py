@@ -1,0 +1,151 @@
+"""One frame's body placement in plain floats: the online walker's hot path.
+
+Why a second implementation: numpy costs microseconds per call whatever the array size, and placing
+the pelvis so that the whole CoM is on the plan takes a few IK + CoM evaluations per frame; with numpy
+that is ~1.5 ms a frame, over the 1 ms budget. For the straight walk the balanced walker plans (root
+upright, soles flat, no yaw) the leg IK and the link CoMs reduce to a few rotations about x and y,
+done here with the math module (~10x faster). tests/gait/test_balance_walker.py checks it against the
+vectorised gaitbot.gait.kinematics6 / gaitbot.gait.mass to 1e-12.
+"""
+
+from __future__ import annotations
+
+import math
+
+from gaitbot.gait.body import LEG_LINKS, SIDE_SIGN, BodyModel
+from gaitbot.gait.joints import SIDES
+from gaitbot.gait.mass import GRAVITY_M_S2
+
+
+class FlatFootBody:
+    """Leg IK, whole-body CoM and gravity torques for an upright root and flat, unturned feet."""
+
+    def __init__(self, body: BodyModel) -> None:
+        g = body.geometry
+        self.l1, self.l2 = g.thigh_m, g.shank_m
+        self.hips = {s: tuple(float(v) for v in g.hip_in_root(s)) for s in SIDES}
+        self.torso_kg = body.torso.mass_kg
+        self.torso_com = tuple(float(v) for v in body.torso.com_m)
+        self.link_kg = [body.leg_links[n].mass_kg for n in LEG_LINKS]
+        self.link_com = {s: [tuple(float(v) for v in body.leg_link(n, s).com_m) for n in LEG_LINKS] for s in SIDES}
+        self.total_kg = self.torso_kg + 2 * sum(self.link_kg)
+
+    def leg_ik(self, side: str, rx: float, ry: float, rz: float) -> list[float]:
+        """One leg's six angles for r = hip - ankle (root frame); the foot flat, toe straight ahead."""
+        s = SIDE_SIGN[side]
+        l1, l2 = self.l1, self.l2
+        cos_knee = (rx * rx + ry * ry + rz * rz - l1 * l1 - l2 * l2) / (2 * l1 * l2)
+        knee = math.acos(min(1.0, max(-1.0, cos_knee)))
+        a6 = math.atan(ry / rz)
+        vz = math.copysign(math.hypot(ry, rz), rz)
+        a5 = -math.atan2(l1 * math.sin(knee), l1 * math.cos(knee) + l2) - math.atan2(rx, vz)
+        # flat foot, no yaw: hip rotation Rx(-a6) Ry(-(knee + a5)): yaw 0, roll -a6, pitch -(knee + a5)
+        return [0.0, -s * a6, knee + a5, knee, -a5, s * a6]
+
+    def link_points(self, side: str, q: list[float]) -> list[tuple[float, float, float]]:
+        """Each leg link's CoM (root frame) for that leg's angles q (hip yaw 0)."""
+        return self._leg(side, q)[0]
+
+    def _leg(self, side: str, q: list[float]):
+        """(link CoMs, knee point, ankle point) in the root frame."""
+        s = SIDE_SIGN[side]
+        hx, hy, hz = self.hips[side]
+        cr, sr = math.cos(s * q[1]), math.sin(s * q[1])
+        out = []
+        # Rx(s roll), then pitch about y: thigh -p, shank -p+k, ankle -p+k-a; the foot adds Rx(s ankle_roll)
+        pitches = (0.0, 0.0, -q[2], -q[2] + q[3], -q[2] + q[3] - q[4], -q[2] + q[3] - q[4])
+        ox, oy, oz = hx, hy, hz
+        knee = (ox, oy, oz)
+        for i, ((cx, cy, cz), b) in enumerate(zip(self.link_com[side], pitches)):
+            if i == 3:  # the knee: thigh_m down the thigh
+                cb, sb = math.cos(pitches[2]), math.sin(pitches[2])
+                ox, oy, oz = hx - self.l1 * sb, hy + self.l1 * sr * cb, hz - self.l1 * cr * cb
+                knee = (ox, oy, oz)
+            elif i == 4:  # the ankle: shank_m down the shank
+                cb, sb = math.cos(pitches[3]), math.sin(pitches[3])
+                ox, oy, oz = ox - self.l2 * sb, oy + self.l2 * sr * cb, oz - self.l2 * cr * cb
+            if i == 0:
+                vx, vy, vz = cx, cy, cz
+            else:
+                if i == 5:
+                    ca, sa = math.cos(s * q[5]), math.sin(s * q[5])
+                    cy, cz = ca * cy - sa * cz, sa * cy + ca * cz
+                cb, sb = math.cos(b), math.sin(b)
+                px, pz = cb * cx + sb * cz, -sb * cx + cb * cz
+                vx, vy, vz = px, cr * cy - sr * pz, sr * cy + cr * pz
+            out.append((ox + vx, oy + vy, oz + vz))
+        return out, knee, (ox, oy, oz)
+
+    def gravity_torques(self, q, share_left: float, cops) -> list[float]:
+        """As MassModel.gravity_torques for one frame: the 12 joint torques (N m) holding the pose;
+        cops[side index] = (x, y) of each foot's centre of pressure in the root frame."""
+        g = GRAVITY_M_S2
+        weight = self.total_kg * g
+        out = []
+        for i, side in enumerate(SIDES):
+            s = SIDE_SIGN[side]
+            share = share_left if side == "left" else 1.0 - share_left
+            leg = q[6 * i:6 * i + 6]
+            points, knee, ankle = self._leg(side, leg)
+            cr, sr = math.cos(s * leg[1]), math.sin(s * leg[1])
+            b5 = -leg[2] + leg[3] - leg[4]
+            axes = ((0.0, 0.0), (s, 0.0), (0.0, -cr), (0.0, cr), (0.0, -cr), (s * math.cos(b5), s * sr * math.sin(b5)))
+            joints = (self.hips[side], self.hips[side], self.hips[side], knee, ankle, ankle)
+            fx, fy = cops[i]
+            for j in range(6):
+                jx, jy = joints[j][0], joints[j][1]
+                # the moment of vertical forces f at (x, y) about the joint: (f (y - jy), -f (x - jx), 0)
+                mx = share * weight * (fy - jy)
+                my = -share * weight * (fx - jx)
+                for k in range(j, 6):
+                    f = -self.link_kg[k] * g
+                    mx += f * (points[k][1] - jy)
+                    my -= f * (points[k][0] - jx)
+                out.append(-(mx * axes[j][0] + my * axes[j][1]))
+        return out
+
+    def legs(self, root, ankles) -> list[float]:
+        """12 angles for an upright root at ``root`` (x, y, z) and flat feet at ankles[side index]."""
+        q = []
+        for i, side in enumerate(SIDES):
+            hx, hy, hz = self.hips[side]
+            ax, ay, az = ankles[i]
+            q += self.leg_ik(side, root[0] + hx - ax, root[1] + hy - ay, root[2] + hz - az)
+        return q
+
+    def com_in_root(self, q) -> tuple[float, float, float]:
+        m = self.torso_kg
+        x, y, z = (m * c for c in self.torso_com)
+        for i, side in enumerate(SIDES):
+            for kg, (px, py, pz) in zip(self.link_kg, self.link_points(side, q[6 * i:6 * i + 6])):
+                x += kg * px
+                y += kg * py
+                z += kg * pz
+        return x / self.total_kg, y / self.total_kg, z / self.total_kg
+
+    def place(self, com_x: float, com_y: float, ankles, root_z: float, guess_dx: float, guess_dy: float,
+              slope: float, tolerance_m: float, max_iterations: int):
+        """Root (x, y, z), angles and residual putting the whole CoM at (com_x, com_y) (as
+        gaitbot.gait.balance.placement.WholeBody.place, one frame)."""
+        rx, ry = com_x + guess_dx, com_y + guess_dy
+        sx = sy = slope
+        last = None
+        residual = math.inf
+        q: list[float] = []
+        for _ in range(max_iterations):
+            q = self.legs((rx, ry, root_z), ankles)
+            cx, cy, _ = self.com_in_root(q)
+            cx, cy = rx + cx, ry + cy
+            ex, ey = com_x - cx, com_y - cy
+            residual = max(abs(ex), abs(ey))
+            if residual < tolerance_m:
+                break
+            if last is not None:  # secant slopes, where the root moved enough to measure them
+                if abs(rx - last[0]) > 1e-9:
+                    sx = (cx - last[2]) / (rx - last[0])
+                if abs(ry - last[1]) > 1e-9:
+                    sy = (cy - last[3]) / (ry - last[1])
+            last = (rx, ry, cx, cy)
+            rx += ex / sx
+            ry += ey / sy
+        return (rx, ry, root_z), q, residual

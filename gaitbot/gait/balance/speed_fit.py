@@ -1,0 +1,86 @@
+"""Fit the balanced walk to the servos' speed: relax double support, early progression and clearance
+when a faster cycle or a longer step would ask a joint for more than its velocity limit.
+
+Why: the swing leg is the fastest part of the plan and the servos cap it (the OP3's XM430-W350 turns
+at most 276 deg/s unloaded). A robot's ``[balance]`` values are tuned for robustness at its own cycle
+and step (on the OP3 a 15% double support, the progression done at 80% of the swing); at 0.2 m/s
+(cycle 0.8 s, 8 cm steps) they would ask 434 deg/s. The swing speed scales as
+1 / ((1 - double support) x progression_end) and its lift with the clearance, so the candidates are, in
+order: the robot's values; the same 10 deg deeper in the crouch (the bent knee lifts and swings the foot
+with less speed); double support 10% / progression 0.9; 5% / 1.0 / clearance 3 mm; the last 10 deg deeper;
+the first whose steady walk at the longest step keeps every joint under its limit is used (the last
+if none does: the limit check then says which joint, and when). The walk itself is planned for each
+candidate until one fits (an offline walk of 2 m takes ~0.1 s).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from gaitbot.gait.balance.settings import BalanceSettings
+from gaitbot.gait.balance.walker import (BalancedGaitSettings, BalancedWalk, BalancedWalker, BalancedWalkError,
+                                         plan_balanced_walk, walk_of)
+from gaitbot.gait.body import BodyModel
+
+FALLBACKS = ((1.0, 0.0, None, 10.0), (0.10, 0.9, None, 0.0), (0.05, 1.0, 0.003, 0.0), (0.05, 1.0, 0.003, 10.0))
+"""(double_support_share, progression_end, clearance_m, crouch deeper by deg), tried in order."""
+PROBE_STEPS = 4
+
+
+@dataclass(frozen=True, eq=False)
+class SpeedFit:
+    """The settings walked with, the walk's peak joint speed (deg/s, planned angles or goals) against the
+    limit, which candidate was taken (0: the robot's own values), and the walk (with its walker)."""
+
+    balance: BalanceSettings
+    gait: BalancedGaitSettings
+    peak_dps: float
+    limit_dps: float
+    relaxed: int
+    walk: BalancedWalk | None = None
+    walker: BalancedWalker | None = None
+
+    @property
+    def fits(self) -> bool:
+        return self.peak_dps <= self.limit_dps
+
+
+def peak_joint_speed_dps(q_rad, rate_hz: float) -> float:
+    return float(np.degrees(np.abs(np.diff(q_rad, axis=0))).max() * rate_hz)
+
+
+def candidates(gait: BalancedGaitSettings, balance: BalanceSettings):
+    """The robot's own settings, then FALLBACKS relaxed from them."""
+    out = [(balance, gait)]
+    for ds, progression_end, clearance, deeper_deg in FALLBACKS:
+        relaxed = replace(balance, double_support_share=min(balance.double_support_share, ds),
+                          progression_end=max(balance.progression_end, progression_end),
+                          crouch_knee_deg=balance.crouch_knee_deg + deeper_deg)
+        out.append((relaxed, gait if clearance is None else replace(gait, clearance_m=min(gait.clearance_m,
+                                                                                          clearance))))
+    return out
+
+
+def fit_to_servo_speed(body: BodyModel, gait: BalancedGaitSettings, balance: BalanceSettings, limit_dps: float,
+                       steps=None, **options) -> SpeedFit:
+    """The first candidate whose walk (``steps``; default a steady walk at ``gait.max_step_m``) keeps every
+    leg joint's planned angle and goal under ``limit_dps``; ``options`` go to the walker (limits, stiffness).
+    A candidate the joint limits refuse is skipped; if every one is refused, the first refusal is raised."""
+    steps = [gait.max_step_m] * PROBE_STEPS if steps is None else list(steps)
+    fit, refused = None, None
+    for i, (b, g) in enumerate(candidates(gait, balance)):
+        try:
+            walker = plan_balanced_walk(body, steps, g, b, **options)
+            walk = walk_of(walker)
+        except BalancedWalkError as exc:
+            refused = refused or exc
+            continue
+        peak = max(peak_joint_speed_dps(walk.q_rad, g.rate_hz), peak_joint_speed_dps(walk.goals_rad, g.rate_hz))
+        fit = SpeedFit(b, g, peak, limit_dps, i, walk, walker)
+        if fit.fits:
+            break
+    if fit is None:
+        raise refused
+    return fit

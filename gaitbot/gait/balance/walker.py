@@ -1,0 +1,486 @@
+"""The balanced walker: footholds -> ZMP reference -> preview-controlled CoM -> pelvis -> leg IK.
+
+For a robot whose legs roll (docs/balance.md):
+- footholds and timing (gaitbot.gait.balance.step_plan): exact step lengths, whole frames;
+- the CoM in x and y by Kajita's preview control (gaitbot.gait.balance.preview) on the cart-table model
+  at the robot's own CoM height (the whole robot's, from its mass model, in the walking crouch);
+- a second preview stage (Kajita et al. 2003, section IV): the ZMP of the whole multibody motion
+  (every link a point mass) differs from the cart-table's by up to ~2 cm, mostly from the swing leg;
+  previewing that error as a CoM correction brings the multibody ZMP back onto the reference;
+- the pelvis (root) placed every frame so that the whole robot's CoM is the planned one
+  (gaitbot.gait.balance.placement); the root stays upright at a constant walking height;
+- stance soles flat and still, the swing foot on the planar Boulic swing's shape (swing.py);
+- legs by the analytic 6-joint IK (gaitbot.gait.kinematics6);
+- optional servo-sag feedforward: goal = planned angle + gravity torque / servo stiffness.
+
+Online and offline compute the same frames. ``BalancedWalker.next_frame`` runs both preview stages one
+frame at a time (the first one horizon + 1 frame ahead of the output, since the second needs the
+multibody ZMP error over its horizon), placing the body with flat_frame.py's float code;
+``generate_balanced_walk`` runs the same recursions over a closed walk, vectorised. Steps appended while
+walking enter the horizon at once: until the walk is closed, the frames beyond the queued steps are the
+close-and-stand that ``finish`` would add (so a walker whose queue runs dry stops safely), and
+appending a step reruns the first stage from the next output frame with the new reference.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from gaitbot.gait.balance.flat_frame import FlatFootBody
+from gaitbot.gait.balance.placement import (MAX_PLACEMENT_ITERATIONS, PLACEMENT_TOLERANCE_M, WholeBody,
+                                            multibody_zmp)
+from gaitbot.gait.balance.preview import PreviewController, preview_gains, preview_offline
+from gaitbot.gait.balance.settings import BalanceSettings
+from gaitbot.gait.balance.step_plan import (RISE_S, START_PAUSE_S, Landing, PlanBlocks, StepPlanner,
+                                           feedforward_weight)
+from gaitbot.gait.balance.swing import swing_shapes
+from gaitbot.gait.balance.zmp_reference import Timing, smootherstep
+from gaitbot.gait.body import SIDE_SIGN, BodyModel
+from gaitbot.gait.geometry import LegGeometry
+from gaitbot.gait.joints import LEG_JOINTS
+from gaitbot.gait.planning import PlannedStep
+from gaitbot.gait.segments import GaitGenerationError
+from gaitbot.gait.trajectory import HeelStrike, Trajectory
+
+STEP_LENGTH_TOLERANCE_M = 1e-12
+FEEDFORWARD_SMOOTHING_S = 0.1
+"""The sag feedforward splits the weight between the feet by the planned load share averaged over +- this:
+a short double support (2 frames at 0.2 m/s) would otherwise swing the stance joints' offsets across in
+two frames, asking the servos for more speed than the motion itself."""
+
+
+def smoothed_share(share, rate_hz: float, index=None):
+    """The load share averaged over +- FEEDFORWARD_SMOOTHING_S (edges held), at every frame or at ``index``."""
+    half = max(0, round(FEEDFORWARD_SMOOTHING_S * rate_hz))
+    share = np.asarray(share, dtype=float)
+    if index is not None:
+        window = np.clip(np.arange(index - half, index + half + 1), 0, len(share) - 1)
+        return float(share[window].mean())
+    padded = np.concatenate([np.repeat(share[:1], half), share, np.repeat(share[-1:], half)])
+    return np.convolve(padded, np.ones(2 * half + 1) / (2 * half + 1), mode="valid")
+
+
+class BalancedWalkError(GaitGenerationError):
+    """A balanced walk the robot cannot make (a step too long, a joint past its limit): one line."""
+
+
+@dataclass(frozen=True)
+class BalancedGaitSettings:
+    """The walk's timing and reach: cycle (s, two steps; rounded to whole frames per step), frame rate
+    (Hz), longest step (m) and the swing sole's least height over the middle of each swing (m)."""
+
+    cycle_s: float
+    rate_hz: float
+    max_step_m: float
+    clearance_m: float
+
+
+@dataclass(frozen=True)
+class BalancedWalk:
+    """A walk as arrays over frames: planned angles q_rad (n, 12, LEG_JOINTS order), servo goals (planned
+    + sag feedforward where on), root (n, 3), planned CoM (n, 3), ZMP reference and planned multibody ZMP
+    (n, 2), the ankle points (n, 2, 3), which foot swings (n,), the heel strikes, the steps, and the
+    largest CoM placement residual (m)."""
+
+    t_s: np.ndarray
+    q_rad: np.ndarray
+    goals_rad: np.ndarray
+    root_m: np.ndarray
+    com_m: np.ndarray
+    zmp_ref_m: np.ndarray
+    zmp_plan_m: np.ndarray
+    ankles_m: np.ndarray
+    swinging: np.ndarray
+    heel_strikes: tuple[HeelStrike, ...]
+    planned_steps: tuple[PlannedStep, ...]
+    residual_m: float
+
+    def trajectory(self, goals: bool = False) -> Trajectory:
+        """The planned angles (exact kinematics), or with ``goals`` the angles the servos are sent."""
+        return Trajectory(self.t_s, self.goals_rad if goals else self.q_rad, self.root_m, self.heel_strikes,
+                          LEG_JOINTS)
+
+
+def leg_of(body: BodyModel) -> LegGeometry:
+    """The planar leg of the same robot (for the swing shapes of the planar Boulic walker)."""
+    g = body.geometry
+    return LegGeometry(thigh=g.thigh_m, shank=g.shank_m, foot=g.foot_m, hip_width=g.hip_width_m,
+                       ankle_height=g.ankle_height_m, heel_back=g.heel_back_m)
+
+
+class BalancedWalker:
+    """Online balanced walker: ``append_step`` plans footholds and the ZMP reference; ``next_frame`` runs
+    the preview controllers one frame and places the body: (t_s, q_rad (12,), goal_rad (12,), root_m (3,)),
+    or None after the last frame. Like gaitbot.gait.walker.OnlineWalker, a walker whose queue runs dry
+    closes its feet and stands.
+
+    limits_rad: (lower, upper) arrays (12,) checked by the offline walk; kp_nm_per_rad: each joint's servo
+    stiffness (12,) for the sag feedforward (None: goals are the planned angles)."""
+
+    def __init__(self, body: BodyModel, gait: BalancedGaitSettings, balance: BalanceSettings = BalanceSettings(),
+                 *, limits_rad=None, kp_nm_per_rad=None) -> None:
+        self.body = body
+        self.gait = gait
+        self.balance = balance
+        self.rate_hz = gait.rate_hz
+        self.limits_rad = limits_rad
+        self.kp_nm_per_rad = None if kp_nm_per_rad is None else np.asarray(kp_nm_per_rad, dtype=float)
+        self.feedforward = balance.sag_feedforward and self.kp_nm_per_rad is not None
+        self.timing = Timing.of(gait.cycle_s, gait.rate_hz, balance.double_support_share)
+        shapes = swing_shapes(leg_of(body), gait.max_step_m, self.timing.cycle_s, gait.rate_hz, gait.clearance_m)
+        self.planner = StepPlanner(body.geometry, balance, self.timing, shapes, gait.clearance_m)
+        self.whole = WholeBody(body)
+        self._state = self.planner.start()
+        ankles0 = self.planner.ankles(self._state.feet)
+        root0 = np.array([[np.mean(ankles0[:, 0]), 0.0, self.planner.walk_root_z]])
+        com0 = self.whole.com(root0, ankles0[None])[0]
+        self.com_height_m = float(com0[2])
+        self.standing_offset = root0[0, :2] - com0[:2]
+        self.com_slope = self.whole.com_slope(self.planner.walk_root_z, ankles0 - [root0[0, 0], 0.0, 0.0])
+        horizon = round(balance.preview_horizon_s * gait.rate_hz)
+        self.gains = preview_gains(round(self.com_height_m, 9), 1.0 / gait.rate_hz, horizon,
+                                   balance.preview_jerk_weight)
+        self.heel_strikes: list[HeelStrike] = []
+        self.planned_steps: list[PlannedStep] = []
+        self._blocks = PlanBlocks()
+        self.planner.settle(self._blocks, self._state, bend=True)
+        self.planner.hold(self._blocks, self._state, START_PAUSE_S)
+        self.finished = False
+        self._batch = False
+        self._blocks_done = 0
+        self._arrays: dict = {}
+        self._commit()
+        self._k = 0  # the balance plan's next frame
+        self._out = 0  # the walk's next frame (rise, balance plan, lower)
+        self._primed = False
+        # Rising from straight legs to where the balance plan starts (its first CoM is the ZMP reference's)
+        self.rise_frames = max(1, round(RISE_S * gait.rate_hz))
+        root0, _, _ = self.whole.place(self._arrays["zmp"][:1], ankles0[None], self._arrays["root_z"][:1],
+                                       self.standing_offset, self.com_slope)
+        self._rise = self.straight_path(root0[0], ankles0, rising=True)
+        self._lower = None
+
+    @property
+    def period_s(self) -> float:
+        return 1.0 / self.rate_hz
+
+    # --- planning ------------------------------------------------------------------------------
+    def append_step(self, length_m: float) -> None:
+        """Queue one step: its foot lands ``length_m`` beyond the previous heel strike."""
+        if self.finished:
+            raise RuntimeError("the walk has already been closed; start a new walker")
+        if not (math.isfinite(length_m) and 0.0 <= length_m <= self.gait.max_step_m + STEP_LENGTH_TOLERANCE_M):
+            raise BalancedWalkError(f"step length {length_m!r} m is outside 0..{self.gait.max_step_m:g} m")
+        self._record(self.planner.step(self._blocks, self._state, float(length_m)), closing=False)
+        if not self._batch:
+            self._commit()
+            if self._primed:
+                self._replan_lookahead()
+
+    def finish(self) -> None:
+        """Close the trailing foot beside the leading one, move the weight between the feet and stand."""
+        if self.finished:
+            return
+        for landing in self.planner.close(self._blocks, self._state):
+            self._record(landing, closing=True)
+        self.finished = True
+        self._commit()
+
+    @property
+    def rise_path(self) -> tuple[np.ndarray, np.ndarray]:
+        """(roots, angles) of the rise from straight legs that comes before the balance plan."""
+        return self._rise
+
+    def straight_path(self, root_m, ankles, rising: bool) -> tuple[np.ndarray, np.ndarray]:
+        """(roots (n, 3), angles (n, 12)) between straight legs over ``ankles`` (both feet flat, every joint
+        0) and the pose whose root is ``root_m``: rising, from straight up to just before that pose;
+        else from just after it down to straight. The pelvis moves on a straight line (smootherstep in
+        time), the legs by the IK: the feet stay exactly where they are."""
+        g = self.body.geometry
+        straight = np.array([ankles[:, 0].mean(), 0.0, g.standing_root_height_m])
+        n = self.rise_frames
+        tau = np.arange(n) / n if rising else np.arange(1, n + 1) / n
+        w = smootherstep(tau)[:, None]
+        roots = (straight + w * (root_m - straight)) if rising else (root_m + w * (straight - root_m))
+        q = self.whole.legs(roots, np.repeat(np.asarray(ankles)[None], n, 0))
+        q[0 if rising else -1] = 0.0  # exactly the servos' standing pose
+        return roots, q
+
+    def _record(self, landing: Landing, closing: bool) -> None:
+        g = self.body.geometry
+        t = (landing.frame + self.rise_frames) / self.rate_hz
+        heel_x = landing.ankle_x_m - g.heel_back_m
+        sole_y = landing.ankle_y_m + SIDE_SIGN[landing.side] * g.sole_outward_m
+        self.heel_strikes.append(HeelStrike(t, landing.side, heel_x, sole_y))
+        self.planned_steps.append(PlannedStep(len(self.planned_steps) + 1, landing.side, landing.length_m, None,
+                                              (landing.start_frame + self.rise_frames) / self.rate_hz, t, heel_x,
+                                              closing))
+
+    def _commit(self) -> None:
+        """Refresh the plan arrays: the planned frames, then (until the walk is closed) the provisional
+        close-and-stand; frames past the end repeat the last one (standing)."""
+        blocks = self._blocks
+        if self._blocks_done == 0:
+            self._arrays = blocks.arrays()
+        elif self._blocks_done < len(blocks.zmp):  # only the blocks added since the last commit
+            new = blocks.arrays(self._blocks_done)
+            self._arrays = {k: np.concatenate([self._arrays[k], new[k]]) for k in self._arrays}
+        self._blocks_done = len(blocks.zmp)
+        self._committed = len(self._arrays["zmp"])
+        if self.finished:
+            self._ext = self._arrays
+        else:
+            tail = PlanBlocks()
+            self.planner.close(tail, self._state.copy())
+            t = tail.arrays()
+            self._ext = {k: np.concatenate([self._arrays[k], t[k]]) for k in self._arrays}
+        zmp = self._ext["zmp"]
+        self._zmp_padded = np.concatenate([zmp, np.repeat(zmp[-1:], self.gains.horizon_frames + 2, 0)])
+
+    def plan_arrays(self) -> dict:
+        """The plan's per-frame arrays so far (gaitbot.gait.balance.step_plan.PLAN_KEYS)."""
+        return self._arrays
+
+    def _ext_at(self, name: str, j: int):
+        a = self._ext[name]
+        return a[min(j, len(a) - 1)]
+
+    def _last_frame(self) -> int:
+        """Index of the walk's last frame once closed; unbounded while it is open."""
+        return self._committed - 1 if self.finished else 1 << 60
+
+    # --- online --------------------------------------------------------------------------------
+    def _prime(self) -> None:
+        self._flat = FlatFootBody(self.body)
+        self._stage1 = PreviewController(self.gains, self._arrays["zmp"][0])
+        self._stage2 = PreviewController(self.gains, np.zeros(2))
+        self._s1_next = 0
+        self._s1_offset = tuple(self.standing_offset)
+        self._s1_com, self._s1_points, self._s1_snapshot, self._s1_offsets = {}, {}, {}, {}
+        self._err, self._err_next = np.zeros((256, 2)), 0
+        self._offset = tuple(self.standing_offset)
+        self._previous_offset = None
+        self._primed = True
+
+    def _stage1_until(self, j: int) -> None:
+        """Run the first preview stage and place the body up to frame j (clamped to the last frame)."""
+        horizon = self.gains.horizon_frames
+        flat = self._flat
+        while self._s1_next <= min(j, self._last_frame()):
+            i = self._s1_next
+            self._s1_snapshot[i] = (self._stage1.state.copy(), self._stage1.error_sum.copy())
+            com = self._stage1.state[0].copy()
+            self._stage1.step(self._zmp_padded[i], self._zmp_padded[i + 1:i + 1 + horizon])
+            guess = _extrapolated(self._s1_offset, self._s1_offsets.get(i - 2))
+            root, q, _ = flat.place(com[0], com[1], self._ext_at("ankles", i), float(self._ext_at("root_z", i)),
+                                    guess[0], guess[1], self.com_slope, PLACEMENT_TOLERANCE_M, MAX_PLACEMENT_ITERATIONS)
+            self._s1_offset = (root[0] - com[0], root[1] - com[1])
+            self._s1_offsets[i] = self._s1_offset
+            self._s1_com[i] = com
+            c = flat.torso_com
+            points = [(root[0] + c[0], root[1] + c[1], root[2] + c[2])]
+            for k, side in enumerate(("left", "right")):
+                points += [(root[0] + p[0], root[1] + p[1], root[2] + p[2])
+                           for p in flat.link_points(side, q[6 * k:6 * k + 6])]
+            self._s1_points[i] = np.array(points)
+            self._s1_next += 1
+
+    def _replan_lookahead(self) -> None:
+        """A step appended while walking: rerun the first stage from the next output frame with the new
+        reference (it had previewed the provisional close-and-stand), re-place those frames at once
+        (vectorised) and let the second stage's errors be recomputed from them."""
+        k = self._k
+        if k not in self._s1_snapshot:
+            return
+        state, error_sum = self._s1_snapshot[k]
+        self._stage1.state, self._stage1.error_sum = state.copy(), error_sum.copy()
+        end = min(self._s1_next - 1, self._last_frame())
+        horizon = self.gains.horizon_frames
+        frames = range(k, end + 1)
+        coms = []
+        for i in frames:
+            self._s1_snapshot[i] = (self._stage1.state.copy(), self._stage1.error_sum.copy())
+            coms.append(self._stage1.state[0].copy())
+            self._stage1.step(self._zmp_padded[i], self._zmp_padded[i + 1:i + 1 + horizon])
+        coms = np.array(coms)
+        idx = np.minimum(np.arange(k, end + 1), len(self._ext["zmp"]) - 1)
+        guess = np.array([self._s1_offsets.get(i, self._s1_offset) for i in frames])
+        root, q, _ = self.whole.place(coms, self._ext["ankles"][idx], self._ext["root_z"][idx], guess, self.com_slope)
+        points = self.whole.link_points(root, q)
+        for n, i in enumerate(frames):
+            self._s1_com[i] = coms[n]
+            self._s1_points[i] = points[n]
+            self._s1_offsets[i] = tuple(root[n, :2] - coms[n])
+        self._s1_offset = (root[-1, 0] - coms[-1, 0], root[-1, 1] - coms[-1, 1])
+        self._err_next = min(self._err_next, k)
+
+    def _points(self, j: int) -> np.ndarray:
+        return self._s1_points[max(0, min(j, self._last_frame()))]
+
+    def _zmp_errors_until(self, j: int) -> None:
+        """Multibody (point-mass) ZMP minus the reference for frames up to j (frames past the end: the
+        last frame's, as the offline padding)."""
+        if len(self._err) <= j:
+            grown = np.zeros((max(2 * len(self._err), j + 1), 2))
+            grown[:self._err_next] = self._err[:self._err_next]
+            self._err = grown
+        last = self._last_frame()
+        masses, dt = self.whole.point_masses_kg, 1.0 / self.rate_hz
+        while self._err_next <= j:
+            i = min(self._err_next, last)
+            if i < self._err_next:
+                self._err[self._err_next] = self._err[i]
+            else:
+                window = np.stack([self._points(i - 1 if i > 0 else 0), self._points(i),
+                                   self._points(i + 1 if i < last else i)])
+                self._err[i] = multibody_zmp(window, masses, dt)[0] - self._ext_at("zmp", i)
+            self._err_next += 1
+
+    def next_frame(self):
+        """(t_s, q_rad (12,), goal_rad (12,), root_m (3,)) of the next frame, or None after the last."""
+        j = self._out
+        if j < self.rise_frames:
+            roots, q = self._rise
+            frame = (q[j].copy(), q[j].copy(), roots[j].copy())
+            self._warm_up(j)
+        else:
+            frame = self._balance_frame()
+            if frame is None:
+                if self._lower is None:
+                    self._lower = self.straight_path(self._last_root, self._ext["ankles"][self._committed - 1],
+                                                     rising=False)
+                i = j - self.rise_frames - self._committed
+                if i >= self.rise_frames:
+                    return None
+                roots, q = self._lower
+                frame = (q[i].copy(), q[i].copy(), roots[i].copy())
+        self._out += 1
+        return (j / self.rate_hz, *frame)
+
+    def _warm_up(self, j: int) -> None:
+        """While rising (frames that cost nothing), run the first preview stage a share of the horizon
+        ahead each frame, so that the balance plan's first frame does not pay for a whole horizon."""
+        if not self._primed:
+            self._prime()
+        ahead = self.gains.horizon_frames + 2
+        self._stage1_until(math.ceil((j + 1) * ahead / self.rise_frames) - 1)
+
+    def _balance_frame(self):
+        """The balance plan's next frame: (q, goal, root), or None after its last."""
+        if not self._primed:
+            self._prime()
+        k = self._k
+        if k >= self._committed and not self.finished:
+            self.finish()  # the queue ran dry: close the feet and stand
+        if k >= self._committed:
+            return None
+        horizon = self.gains.horizon_frames
+        self._stage1_until(k + horizon + 1)
+        self._zmp_errors_until(k + horizon)
+        correction = self._stage2.state[0].copy()
+        self._stage2.step(-self._err[k], -self._err[k + 1:k + 1 + horizon])
+        com = self._s1_com[k] + correction
+        flat = self._flat
+        guess = _extrapolated(self._offset, self._previous_offset)
+        root, q, _ = flat.place(com[0], com[1], self._ext_at("ankles", k), float(self._ext_at("root_z", k)),
+                                guess[0], guess[1], self.com_slope, PLACEMENT_TOLERANCE_M, MAX_PLACEMENT_ITERATIONS)
+        self._previous_offset = self._offset
+        self._offset = (root[0] - com[0], root[1] - com[1])
+        for cache in (self._s1_com, self._s1_points, self._s1_snapshot, self._s1_offsets):  # drop the past
+            cache.pop(k - 2, None)
+        goal = q
+        if self.feedforward:
+            cops = self._arrays["cops"][k]
+            torque = flat.gravity_torques(q, smoothed_share(self._ext["share_left"], self.rate_hz, k),
+                                          ((cops[0, 0] - root[0], cops[0, 1] - root[1]),
+                                           (cops[1, 0] - root[0], cops[1, 1] - root[1])))
+            last = self._committed - 1 if self.finished else math.inf
+            w = float(feedforward_weight(k, last, self.rate_hz))
+            goal = [a + w * t / kp for a, t, kp in zip(q, torque, self.kp_nm_per_rad)]
+        self._k += 1
+        self._last_root = np.array(root)
+        return np.array(q), np.array(goal), np.array(root)
+
+
+def _extrapolated(offset, previous) -> tuple[float, float]:
+    """The next frame's root - CoM offset guessed from the last two (the placement then needs 2 to 3
+    iterations instead of 4 to 5)."""
+    if previous is None:
+        return offset
+    return 2 * offset[0] - previous[0], 2 * offset[1] - previous[1]
+
+
+def plan_balanced_walk(body: BodyModel, step_lengths, gait: BalancedGaitSettings,
+                       balance: BalanceSettings = BalanceSettings(), **options) -> BalancedWalker:
+    """A closed walker with every step queued (nothing computed past the plan yet)."""
+    walker = BalancedWalker(body, gait, balance, **options)
+    walker._batch = True
+    for length in step_lengths:
+        walker.append_step(length)
+    walker._batch = False
+    walker.finish()
+    return walker
+
+
+def generate_balanced_walk(body: BodyModel, step_lengths, gait: BalancedGaitSettings,
+                           balance: BalanceSettings = BalanceSettings(), **options) -> BalancedWalk:
+    """A whole walk as arrays (offline, vectorised): the same frames as BalancedWalker.next_frame."""
+    walker = plan_balanced_walk(body, step_lengths, gait, balance, **options)
+    return walk_of(walker)
+
+
+def walk_of(walker: BalancedWalker) -> BalancedWalk:
+    """Every frame of a closed walker that has handed out none, computed offline."""
+    if not walker.finished or walker._out:
+        raise RuntimeError("walk_of needs a closed walker that has not walked")
+    a = walker.plan_arrays()
+    whole, gains = walker.whole, walker.gains
+    n = len(a["zmp"])
+    dt = 1.0 / walker.rate_hz
+    com1 = preview_offline(gains, a["zmp"])  # first stage: the cart-table's CoM for the ZMP reference
+    root1, q1, _ = whole.place(com1, a["ankles"], a["root_z"], walker.standing_offset, walker.com_slope)
+    points = whole.link_points(root1, q1)  # second stage: preview the multibody ZMP's error
+    error = multibody_zmp(np.concatenate([points[:1], points, points[-1:]]), whole.point_masses_kg, dt) - a["zmp"]
+    com_xy = com1 + preview_offline(gains, -error, com_xy0=np.zeros(2))
+    root, q, residual = whole.place(com_xy, a["ankles"], a["root_z"], walker.standing_offset, walker.com_slope)
+    goals = q
+    if walker.feedforward:
+        w = feedforward_weight(np.arange(n), n - 1, walker.rate_hz)[:, None]
+        share = smoothed_share(a["share_left"], walker.rate_hz)
+        goals = q + w * (whole.sag_goals(q, share, a["cops"], root, walker.kp_nm_per_rad) - q)
+    # the rise from straight legs before the balance plan, and the way back down after it
+    rise_root, rise_q = walker.rise_path
+    lower_root, lower_q = walker.straight_path(root[-1], a["ankles"][-1], rising=False)
+    m = walker.rise_frames
+
+    def framed(before, middle, after):
+        return np.concatenate([before, middle, after])
+
+    root = framed(rise_root, root, lower_root)
+    q = framed(rise_q, q, lower_q)
+    goals = framed(rise_q, goals, lower_q)
+    _check_limits(walker, q)
+    _check_limits(walker, goals)
+    ankles = framed(np.repeat(a["ankles"][:1], m, 0), a["ankles"], np.repeat(a["ankles"][-1:], m, 0))
+    zmp_ref = framed(np.repeat(a["zmp"][:1], m, 0), a["zmp"], np.repeat(a["zmp"][-1:], m, 0))
+    swinging = framed(np.zeros(m, np.int8), a["swinging"], np.zeros(m, np.int8))
+    com = root + whole.mass.com_in_root(q)
+    points = whole.link_points(root, q)
+    zmp_plan = multibody_zmp(np.concatenate([points[:1], points, points[-1:]]), whole.point_masses_kg, dt)
+    return BalancedWalk(np.arange(len(q)) / walker.rate_hz, q, goals, root, com, zmp_ref, zmp_plan, ankles,
+                        swinging, tuple(walker.heel_strikes), tuple(walker.planned_steps), residual)
+
+
+def _check_limits(walker: BalancedWalker, q) -> None:
+    if walker.limits_rad is None:
+        return
+    lower, upper = walker.limits_rad
+    bad = (q < np.asarray(lower) - 1e-9) | (q > np.asarray(upper) + 1e-9)
+    if bad.any():
+        frame, joint = np.argwhere(bad)[0]
+        raise BalancedWalkError(f"frame {frame} ({frame / walker.rate_hz:.2f} s): {LEG_JOINTS[joint]} would go to "
+                                f"{math.degrees(q[frame, joint]):.1f} deg, outside its limits "
+                                f"{math.degrees(lower[joint]):.1f}..{math.degrees(upper[joint]):.1f} deg")

@@ -1,0 +1,130 @@
+"""From a robot config to the balanced walker (gaitbot.gait.balance) for robots whose legs roll.
+
+A robot with hip and ankle roll joints (``config.is_3d``) walks with the balanced walker: its body model
+(``[links.*]``), ``[balance]`` settings, ``[gait]`` cycle, rate, longest step and clearance, its joint
+limits, and the stiffness its servos are given (``[servo] full_torque_error_deg`` written to them, else
+their factory gain) for the sag feedforward. Pitch-only robots keep the planar Boulic walker
+(gaitbot.gait.walker, via walk_settings.py).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from gaitbot.gait.balance.speed_fit import SpeedFit, fit_to_servo_speed
+from gaitbot.gait.balance.walker import (BalancedGaitSettings, BalancedWalk, BalancedWalker, BalancedWalkError,
+                                         walk_of, plan_balanced_walk)
+from gaitbot.gait.joints import LEG_JOINTS
+from gaitbot.robot.config import RobotConfig
+
+
+def balanced_gait_settings(config: RobotConfig, *, cycle_s: float | None = None, rate_hz: float | None = None,
+                           max_step_m: float | None = None, clearance_m: float | None = None) -> BalancedGaitSettings:
+    """``[gait]`` with the command line's overrides."""
+    g = config.gait
+    return BalancedGaitSettings(cycle_s=cycle_s or g.cycle_s, rate_hz=rate_hz or g.rate_hz,
+                                max_step_m=max_step_m or g.max_step_m,
+                                clearance_m=g.clearance_m if clearance_m is None else clearance_m)
+
+
+def _leg_joint(config: RobotConfig, name: str):
+    for joint in config.joints:
+        if joint.name == name:
+            return joint
+    return None
+
+
+def full_torque_error_deg(config: RobotConfig, name: str) -> float:
+    """The stiffness a leg servo walks with: the ``[servo]`` setting written to it, else its factory gain's."""
+    joint = _leg_joint(config, name)
+    if config.servo.full_torque_error_deg is not None:
+        return config.servo.full_torque_error_deg
+    return joint.model.full_torque_error_deg
+
+
+def servo_stiffness_nm_per_rad(config: RobotConfig) -> np.ndarray:
+    """Each leg joint's position-loop stiffness kp = stall torque / full-torque error (N m/rad, LEG_JOINTS
+    order; the servo models' datasheet stall torques, gaitbot.servos.models, or the ``[servo]`` override)."""
+    out = []
+    for name in LEG_JOINTS:
+        joint = _leg_joint(config, name)
+        stall = config.servo.stall_torque_nm or joint.model.stall_torque_nm
+        out.append(stall / math.radians(full_torque_error_deg(config, name)))
+    return np.array(out)
+
+
+def leg_limits_rad(config: RobotConfig) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) of the 12 leg joints in LEG_JOINTS order (a held joint: its hold angle)."""
+    lower, upper = [], []
+    for name in LEG_JOINTS:
+        j = _leg_joint(config, name)
+        lo, hi = (j.hold_deg, j.hold_deg) if j.hold_deg is not None else (j.min_deg, j.max_deg)
+        lower.append(math.radians(lo))
+        upper.append(math.radians(hi))
+    return np.array(lower), np.array(upper)
+
+
+def velocity_limit_dps(config: RobotConfig) -> float:
+    return min(j.max_velocity_dps for j in config.walking_joints)
+
+
+def check_balanced_robot(config: RobotConfig) -> None:
+    """The balanced walker moves all twelve leg joints; a robot must have them (held ones at 0)."""
+    for name in LEG_JOINTS:
+        j = _leg_joint(config, name)
+        if j is None:
+            raise BalancedWalkError(f"{config.path}: the balanced walk needs joint {name} (robots with hip and "
+                                    f"ankle roll have all of {', '.join(LEG_JOINTS)})")
+        if j.hold_deg is not None and abs(j.hold_deg) > 1e-9:
+            raise BalancedWalkError(f"{config.path}: joints.{name} is held at {j.hold_deg:g} deg; the balanced "
+                                    f"walk keeps it at 0 deg")
+
+
+def balanced_walker(config: RobotConfig, gait: BalancedGaitSettings | None = None, balance=None) -> BalancedWalker:
+    """An online balanced walker for the robot (steps appended while walking)."""
+    check_balanced_robot(config)
+    return BalancedWalker(config.body, gait or balanced_gait_settings(config), balance or config.balance,
+                          limits_rad=leg_limits_rad(config), kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
+
+
+@dataclass(frozen=True)
+class BalancedPlan:
+    """A planned balanced walk: the walk's arrays, the speed fit that chose its settings, and the
+    walker (heel strikes, planned steps) as the app and the simulation read them."""
+
+    walk: BalancedWalk
+    fit: SpeedFit
+    walker: BalancedWalker
+
+    @property
+    def heel_strikes(self):
+        return self.walk.heel_strikes
+
+    @property
+    def planned_steps(self):
+        return self.walk.planned_steps
+
+
+def plan_balanced(config: RobotConfig, step_lengths, gait: BalancedGaitSettings | None = None,
+                  speed_fit: bool = True) -> BalancedPlan:
+    """The whole walk, offline; with ``speed_fit`` the robot's ``[balance]`` is relaxed first where the
+    cycle or step would ask a joint for more than its max_velocity_dps (gaitbot.gait.balance.speed_fit)."""
+    check_balanced_robot(config)
+    gait = gait or balanced_gait_settings(config)
+    options = dict(limits_rad=leg_limits_rad(config), kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
+    if speed_fit:
+        fit = fit_to_servo_speed(config.body, gait, config.balance, velocity_limit_dps(config), step_lengths,
+                                 **options)
+        return BalancedPlan(fit.walk, fit, fit.walker)
+    walker = plan_balanced_walk(config.body, step_lengths, gait, config.balance, **options)
+    walk = walk_of(walker)
+    return BalancedPlan(walk, SpeedFit(config.balance, gait, float("nan"), velocity_limit_dps(config), 0, walk, walker),
+                        walker)
+
+
+def with_balance(config: RobotConfig, **changes) -> RobotConfig:
+    """The config with some ``[balance]`` settings changed (tools and tests)."""
+    return replace(config, balance=replace(config.balance, **changes))

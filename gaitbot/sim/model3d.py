@@ -1,0 +1,150 @@
+"""The simulated robot in 3D, built from the robot config alone: every joint, every link's inertia.
+
+Bodies: the torso (``[links.torso]``: the pelvis with held arms and head, lumped) and per leg
+hip_yaw -> hip_roll -> thigh -> shank -> ankle -> foot (gaitbot.gait.body), each with its mass, centre
+of mass and full inertia from ``config.body``, its joint where the config has one (a joint the config
+does not list is welded at 0), axes in gaitbot's sign conventions (gaitbot.gait.kinematics6), so
+MuJoCo's joint angle *is* the trajectory's angle. A robot with a ``[mass]`` table of four segments gets
+the body model gaitbot.gait.body makes of it. Feet: one box of foot_m x foot_width_m per foot, its
+underside ankle_height_m below the ankle point, centred heel_back_m / sole_outward_m as configured.
+Thigh, shank and torso carry massless collision shapes only so that a fall (a part other than a sole on
+the floor) is seen; the robot never collides with itself.
+
+Support (``support``): "free", a free-floating torso (the default of ``gaitbot walk --sim``); "boom",
+the torso on today's boom (slides along x and z, pitch held); "boom-pitch", the boom with a free pitch
+hinge. Servos, contacts and the timestep are those of the planar model (gaitbot.sim.model): a clipped
+P loop with back-EMF damping and the gearbox's armature, stiff contacts, <= 1 ms steps.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from gaitbot.gait.body import LEG_LINKS, SIDE_SIGN
+from gaitbot.gait.joints import LEG_JOINT_KINDS, SIDES
+from gaitbot.robot.config import RobotConfig
+from gaitbot.sim.model import (CONTACT_SOLIMP, CONTACT_SOLREF, FLOOR_FRICTION, IMPRATIO, LEG_RGBA, SOLE_THICKNESS_M,
+                               JointDrive, substeps_per_frame)
+
+SUPPORTS = ("free", "boom", "boom-pitch")
+MIN_MOVING_LINK_KG = 1e-4  # MuJoCo needs mass on a body that moves; a massless link of a pitch-only leg gets this
+MIN_MOVING_LINK_INERTIA_KG_M2 = 1e-9
+
+
+def joint_axis(kind: str, side: str) -> tuple[float, float, float]:
+    """A joint's axis in the root frame at the zero pose (positive angle = the convention's sense)."""
+    s = SIDE_SIGN[side]
+    return {"hip_yaw": (0, 0, s), "hip_roll": (s, 0, 0), "hip_pitch": (0, -1, 0), "knee_pitch": (0, 1, 0),
+            "ankle_pitch": (0, -1, 0), "ankle_roll": (s, 0, 0)}[kind]
+
+
+def _f(*values) -> str:
+    return " ".join(f"{float(v):.9g}" for v in values)
+
+
+def _inertial(link, moving: bool) -> str:
+    mass, inertia = link.mass_kg, link.inertia_kg_m2
+    if mass < MIN_MOVING_LINK_KG:
+        if not moving:
+            return ""
+        mass, inertia = MIN_MOVING_LINK_KG, np.eye(3) * MIN_MOVING_LINK_INERTIA_KG_M2
+    i = inertia
+    return (f'<inertial pos="{_f(*link.com_m)}" mass="{_f(mass)}" '
+            f'fullinertia="{_f(i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2])}"/>')
+
+
+def capsule_radius_m(config: RobotConfig) -> float:
+    return 0.055 * config.body.geometry.leg_length_m
+
+
+def _leg(config: RobotConfig, side: str, drives: dict[str, JointDrive]) -> str:
+    g = config.body.geometry
+    radius = capsule_radius_m(config)
+    colour = LEG_RGBA[side]
+    gap = radius + 0.005  # collision capsules stop short of the joints (a knee or ankle bracket is not a bone)
+    shapes = {
+        "thigh": f'<geom name="thigh_{side}" type="capsule" fromto="0 0 {_f(-gap)} 0 0 {_f(-g.thigh_m + gap)}" '
+                 f'size="{_f(radius)}" mass="0" rgba="{colour}"/>',
+        "shank": f'<geom name="shank_{side}" type="capsule" fromto="0 0 {_f(-gap)} 0 0 {_f(-g.shank_m + gap)}" '
+                 f'size="{_f(radius)}" mass="0" rgba="{colour}"/>',
+    }
+    sole = g.sole_centre_in_foot(side)
+    half = (g.foot_m / 2, g.foot_width_m / 2, SOLE_THICKNESS_M / 2)
+    shapes["foot"] = (
+        f'<geom name="sole_{side}" type="box" pos="{_f(sole[0], sole[1], sole[2] + SOLE_THICKNESS_M / 2)}" '
+        f'size="{_f(*half)}" mass="0" rgba="0.2 0.2 0.25 1"/>'
+        f'<geom name="bracket_{side}" type="capsule" fromto="0 0 0 0 0 {_f(-g.ankle_height_m + SOLE_THICKNESS_M)}" '
+        f'size="{_f(radius * 0.8)}" contype="0" conaffinity="0" mass="0" rgba="{colour}"/>'
+        f'<site name="touch_{side}" type="box" pos="{_f(sole[0], sole[1], sole[2] + SOLE_THICKNESS_M / 4)}" '
+        f'size="{_f(half[0] + 1e-3, half[1] + 1e-3, SOLE_THICKNESS_M)}" rgba="0 0 0 0"/>'
+        f'<site name="sole_{side}" pos="{_f(*sole)}" size="0.003" rgba="0 0 0 0"/>')
+    offsets = {"hip_yaw": g.hip_in_root(side), "hip_roll": (0, 0, 0), "thigh": (0, 0, 0), "shank": (0, 0, -g.thigh_m),
+               "ankle": (0, 0, -g.shank_m), "foot": (0, 0, 0)}
+    text, closing = "", ""
+    for kind, link in zip(LEG_JOINT_KINDS, LEG_LINKS):
+        name = f"{kind}_{side}"
+        drive = drives.get(name)
+        joint = ""
+        if drive is not None:
+            joint = (f'<joint name="{name}" axis="{_f(*joint_axis(kind, side))}" range="{_f(drive.min_deg, drive.max_deg)}" '
+                     f'damping="{_f(drive.damping_nm_s_per_rad)}" armature="{_f(drive.armature_kg_m2)}"/>')
+        text += (f'<body name="{link}_{side}" pos="{_f(*offsets[link])}">{joint}'
+                 f'{_inertial(config.body.leg_link(link, side), drive is not None)}{shapes.get(link, "")}')
+        closing += "</body>"
+    return text + closing
+
+
+def build_mjcf_3d(config: RobotConfig, drives: tuple[JointDrive, ...], rate_hz: float, support: str = "free") -> str:
+    """The MJCF document of the robot standing straight with its soles on the floor at z = 0 (the root at
+    the standing height); ``drives``: the modelled joints' servos, in the order of the actuators."""
+    if support not in SUPPORTS:
+        raise ValueError(f"support must be one of {SUPPORTS}, got {support!r}")
+    g = config.body.geometry
+    by_name = {d.name: d for d in drives}
+    timestep = 1.0 / (rate_hz * substeps_per_frame(rate_hz))
+    radius = capsule_radius_m(config)
+    torso_half = (max(g.foot_m / 3, 0.02), g.hip_width_m / 2 + radius, 0.3 * g.leg_length_m)
+    torso_centre_z = torso_half[2] - g.hip_below_root_m  # a box standing on the hips
+    if support == "free":
+        root_joints = '<freejoint name="root"/>'
+    else:
+        root_joints = ('<joint name="boom_x" type="slide" axis="1 0 0"/><joint name="boom_z" type="slide" axis="0 0 1"/>'
+                       + ('<joint name="boom_pitch" type="hinge" axis="0 1 0"/>' if support == "boom-pitch" else ""))
+    actuators = "\n    ".join(
+        f'<position name="{d.name}" joint="{d.name}" kp="{_f(d.kp_nm_per_rad)}" '
+        f'forcerange="{_f(-d.stall_torque_nm, d.stall_torque_nm)}" '
+        f'ctrlrange="{_f(math.radians(d.min_deg), math.radians(d.max_deg))}"/>' for d in drives)
+    sensors = "\n    ".join(f'<touch name="touch_{side}" site="touch_{side}"/>' for side in SIDES)
+    legs = "".join(_leg(config, side, by_name) for side in SIDES)
+    return f"""<mujoco model="{config.name}">
+  <compiler angle="degree" autolimits="true"/>
+  <option timestep="{_f(timestep)}" integrator="implicitfast" cone="elliptic" impratio="{_f(IMPRATIO)}"/>
+  <visual><global offwidth="640" offheight="480"/></visual>
+  <default>
+    <geom contype="2" conaffinity="1" condim="3" friction="{_f(FLOOR_FRICTION, 0.005, 0.0001)}"
+          solref="{_f(*CONTACT_SOLREF)}" solimp="{_f(*CONTACT_SOLIMP)}"/>
+  </default>
+  <asset>
+    <texture name="grid" type="2d" builtin="checker" rgb1="0.92 0.92 0.92" rgb2="0.78 0.8 0.84" width="256" height="256"/>
+    <material name="grid" texture="grid" texrepeat="1 1" texuniform="true"/>
+  </asset>
+  <worldbody>
+    <light pos="0 -2 3" dir="0 1 -1.5" directional="true"/>
+    <geom name="floor" type="plane" size="0 0 0.05" material="grid" contype="1" conaffinity="2"/>
+    <body name="torso" pos="0 0 {_f(g.standing_root_height_m)}">
+      {root_joints}
+      {_inertial(config.body.torso, True)}
+      <geom name="torso" type="box" pos="0 0 {_f(torso_centre_z)}" size="{_f(*torso_half)}" mass="0" rgba="0.3 0.45 0.7 1"/>
+      {legs}
+    </body>
+  </worldbody>
+  <actuator>
+    {actuators}
+  </actuator>
+  <sensor>
+    {sensors}
+  </sensor>
+</mujoco>
+"""

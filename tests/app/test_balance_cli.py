@@ -1,0 +1,57 @@
+"""The command line picks the walker by robot: --cycle on plan/generate/walk, generate --goals, the
+balanced plan's JSON, and what a balanced robot refuses (one line, exit 2)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from gaitbot.gait.trajectory import Trajectory
+from helpers import run_cli
+
+
+def plan_json(capsys, *args) -> dict:
+    code, out, _ = run_cli(capsys, "plan", "--json", *args)
+    assert code == 0
+    return json.loads(out)
+
+
+@pytest.mark.parametrize("robot", ["xl430-biped", "op3"])
+def test_cycle_overrides_the_configs_cycle(robot, capsys):
+    plan = plan_json(capsys, "--robot", robot, "--distance", "0.3", "--cycle", "1.0")
+    assert plan["cycle_s"] == pytest.approx(1.0)
+    steps = plan["steps"]
+    assert steps[1]["end_s"] - steps[0]["end_s"] == pytest.approx(0.5)  # two steps a cycle
+
+
+def test_a_balanced_plan_says_how_it_walks(capsys):
+    plan = plan_json(capsys, "--robot", "op3", "--distance", "0.5")
+    assert plan["walker"] == "balanced" and plan["sag_feedforward"] is True
+    assert plan["total_distance_m"] == pytest.approx(0.5) and all(s["rv"] is None for s in plan["steps"])
+    assert [h["y_m"] for h in plan["heel_strikes"][:2]] == pytest.approx([-0.0475, 0.0475])
+    assert plan["preview_horizon_s"] == 1.0 and 0.2 < plan["com_height_m"] < 0.3
+    assert plan["peak_joint_speed_dps"] < 240.0
+
+
+def test_generate_goals_add_the_sag_feedforward_on_a_balanced_robot_only(capsys, tmp_path):
+    for robot, differ in (("op3", True), ("xl430-biped", False)):
+        planned, goals = tmp_path / f"{robot}.csv", tmp_path / f"{robot}-goals.csv"
+        assert run_cli(capsys, "generate", "--robot", robot, "--distance", "0.3", "-o", planned)[0] == 0
+        assert run_cli(capsys, "generate", "--robot", robot, "--distance", "0.3", "--goals", "-o", goals)[0] == 0
+        a, b = Trajectory.load(planned), Trajectory.load(goals)
+        assert a.joints == b.joints and np.array_equal(a.root_m, b.root_m)
+        gap = np.degrees(np.abs(a.angles_rad - b.angles_rad)).max()
+        assert (0.5 < gap < 3.0) if differ else gap == 0.0
+
+
+@pytest.mark.parametrize("args, message", [
+    (["plan", "--robot", "op3", "--distance", "1", "--cycle", "-1"], "--cycle must be a positive number"),
+    (["walk", "--dry-run", "--robot", "op3", "--distance", "0.5", "--cycle", "0.4"], "walk refused before anything moved"),
+    (["plan", "--robot", "op3", "--terrain", "config/terrain/kerb.toml"], "walks on the flat only"),
+    (["plan", "--robot", "op3", "--steps", "0.05,0.3"], "--steps: step 2 is 0.3 m"),
+])
+def test_what_a_balanced_walk_refuses_is_one_line_and_exit_2(args, message, capsys):
+    code, _, err = run_cli(capsys, *args)
+    assert code == 2 and message in err and "\n" not in err.strip()
