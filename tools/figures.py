@@ -22,6 +22,7 @@ beside them. Pictures are redrawn by the commands in PICTURES.
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import shlex
 import shutil
@@ -37,7 +38,7 @@ REGION = re.compile(r"<!-- figure ([\w-]+): (.+?) -->\n(.*?)<!-- /figure -->", r
 PRINTED = re.compile(r"<!-- figure ([\w-]+) -->\n(.*?)<!-- /figure -->", re.S)
 NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
 
-#: Pictures in the docs and the commands that draw them (run in a temporary folder that links config/).
+#: Pictures in the docs and the commands that draw them (run in a temporary folder that links config/ and tools/).
 PICTURES = {
     "docs/walk.png": ["gaitbot generate --distance 1.0 -o walk.csv",
                       "gaitbot plot walk.csv -o walk.png"],
@@ -47,7 +48,19 @@ PICTURES = {
                        "--steps $s,$s,$s,$s,$s,$s -o ex_$s.npz; done",
                        "gaitbot eigen fit ex_*.npz -o model.npz",
                        "gaitbot plot model.npz -o eigen.png"],
+    "docs/zero-pose.png": ["python tools/bringup_figures.py zero-pose zero-pose.png"],
+    # a servo heating under load on the emulator (docs/bring-up.md): the walk stops at the stop temperature (exit 1)
+    "docs/health-walk.png": ["python tools/servo_emulator.py --robot config/xl430-biped.toml --load 3:90 "
+                             "--temperature 3:59 --heat-rate 4 > emulator.txt & sleep 2; "
+                             "gaitbot walk --robot config/xl430-biped.toml --steps 0.05,0.05 "
+                             "--port $(head -1 emulator.txt) --record heat.jsonl; kill %1; test -s heat.jsonl",
+                             "python tools/bringup_figures.py health heat.jsonl health-walk.png"],
 }
+
+
+def _this_python_first() -> dict:
+    """The environment with this Python's folder first on PATH: ``python`` and ``gaitbot`` are this install's."""
+    return {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}"}
 
 
 @dataclass(frozen=True)
@@ -155,9 +168,11 @@ def draw_pictures(names) -> None:
         if names and Path(picture).stem not in names and picture not in names:
             continue
         with tempfile.TemporaryDirectory() as folder:
-            (Path(folder) / "config").symlink_to(ROOT / "config")
+            for name in ("config", "tools"):
+                (Path(folder) / name).symlink_to(ROOT / name)
             for command in commands:
-                subprocess.run(["bash", "-c", command], cwd=folder, check=True, stdout=subprocess.DEVNULL)
+                subprocess.run(["bash", "-c", command], cwd=folder, check=True, stdout=subprocess.DEVNULL,
+                               env=_this_python_first())
             shutil.copyfile(Path(folder) / Path(picture).name, ROOT / picture)
         print(f"drew {picture}")
 

@@ -48,17 +48,22 @@ WALKS = {
 }
 
 
-def plan(args: list[str]):
-    parsed = argparse.Namespace(robot="op3", steps=None, distance=None, max_step=None, perturb=0.0, seed=None,
+def plan_arguments(args: list[str], robot: str = "op3") -> argparse.Namespace:
+    """``gaitbot generate``'s options for ``args`` (e.g. ["--distance", "2"]), as its parser leaves them."""
+    parsed = argparse.Namespace(robot=robot, steps=None, distance=None, max_step=None, perturb=0.0, seed=None,
                                 cycle=None, rate=None, clearance=None, thigh=None, shank=None, foot=None,
-                                terrain=None, trajectory=None)
+                                terrain=None, trajectory=None, calibration=None)
     i = 0
     while i < len(args):
         key = args[i][2:].replace("-", "_")
         value = args[i + 1]
         setattr(parsed, key, value if key == "steps" else (int(value) if key == "seed" else float(value)))
         i += 2
-    _, walker, planned = trajectory_for_robot(parsed)
+    return parsed
+
+
+def plan(args: list[str]):
+    _, walker, planned = trajectory_for_robot(plan_arguments(args))
     return walker, planned, walker.walk.trajectory(goals=True)
 
 

@@ -1,10 +1,11 @@
-"""The simulated robot's figures: flat walks of the shipped robots, and what the two walking settings of the
-configs are worth (the sim extra).
+"""The simulated robot's figures: the balanced op3 free-floating, flat walks of the pitch-only robots on the
+boom, and what the two walking settings of their configs are worth (the sim extra).
 
     python tools/sim_figures.py               # the figures, as text
     python tools/sim_figures.py --markdown    # the figures of docs/simulation.md (tools/figures.py)
 
-Every figure is a ``gaitbot walk --sim --json`` run through the command line itself: per robot, 1 m with the
+Every figure is a ``gaitbot walk --sim --json`` run through the command line itself: the op3 walks of
+OP3_WALKS (issue 15's targets); per pitch-only robot, 1 m with the
 pitch held and with it free; the same walks with the ankle at the heel (``heel_back_m = 0``), at the servos'
 factory gains (no ``[servo] full_torque_error_deg``), and both; and toe drag (``--clearance 0``) at factory
 and at the shipped gains. The simulation is deterministic: a run gives the same figures on every machine.
@@ -29,6 +30,16 @@ from gaitbot.app.progress import progress  # noqa: E402
 
 ROBOTS = ("xl430-biped", "sts3215-biped", "ax12a-biped")
 DISTANCE = "1.0"
+#: The balanced op3 walks of docs/simulation.md: (what the row says, gaitbot walk's arguments).
+OP3_WALKS = (
+    ("`--distance 2`", ["--distance", "2"]),
+    ("`--distance 2 --max-step 0.04 --perturb 0.01 --seed 1` (varied)",
+     ["--distance", "2", "--max-step", "0.04", "--perturb", "0.01", "--seed", "1"]),
+    ("`--steps 0.05,0.03,...` (25 pairs, asymmetric)", ["--steps", ",".join(["0.05,0.03"] * 25)]),
+    ("`--distance 2 --cycle 0.8 --max-step 0.08` (0.2 m/s)", ["--distance", "2", "--cycle", "0.8", "--max-step", "0.08"]),
+    ("`--distance 2 --push 0.7`", ["--distance", "2", "--push", "0.7"]),
+    ("`--distance 2 --push -0.7`", ["--distance", "2", "--push", "-0.7"]),
+)
 
 
 def variant(name: str, folder: Path, ankle_at_heel: bool, factory_gains: bool) -> str:
@@ -52,8 +63,12 @@ def sim(*args: str) -> dict:
 
 def measure() -> dict:
     runs = {}
-    with tempfile.TemporaryDirectory() as tmp, progress("simulated walks", total=7 * len(ROBOTS), unit="walk") as bar:
+    total = 7 * len(ROBOTS) + len(OP3_WALKS)
+    with tempfile.TemporaryDirectory() as tmp, progress("simulated walks", total=total, unit="walk") as bar:
         folder = Path(tmp)
+        for label, args in OP3_WALKS:
+            runs["op3", label] = sim("--robot", "op3", *args)
+            bar.update(1)
         for name in ROBOTS:
             def run(key, *args):
                 runs[name, key] = sim(*args)
@@ -70,6 +85,20 @@ def measure() -> dict:
 
 def _travelled(r: dict) -> str:
     return f"{r['distance_travelled_m']:.3f} ({100 * r['distance_travelled_m'] / r['distance_planned_m']:.0f}%)"
+
+
+def op3_table(runs: dict) -> str:
+    rows = ["| ARGS | travelled of planned m | drift cm | yaw end / max deg | roll RMS / max deg | "
+            "pitch RMS / max deg | max foothold error mm | simulated s |", "|---|---|---|---|---|---|---|---|"]
+    for label, _ in OP3_WALKS:
+        r = runs["op3", label]
+        fell = f" FELL at {r['fell_at_s']:.2f} s" if r["fell"] else ""
+        rows.append(f"| {label} | {_travelled(r)} of {r['distance_planned_m']:.3f}{fell} | "
+                    f"{100 * r['lateral_drift_m']:.1f} | {r['yaw_deg']:.1f} / {r['max_abs_yaw_deg']:.1f} | "
+                    f"{r['torso_roll_rms_deg']:.2f} / {r['torso_roll_max_deg']:.1f} | "
+                    f"{r['torso_pitch_rms_deg']:.2f} / {r['torso_pitch_max_deg']:.1f} | "
+                    f"{1000 * r['max_foothold_error_m']:.0f} | {r['simulated_s']:.1f} |")
+    return "\n".join(rows)
 
 
 def markdown(runs: dict) -> str:
@@ -90,7 +119,13 @@ def markdown(runs: dict) -> str:
                      f"{100 * runs[name, 'drag, factory']['scuff_fraction']:.0f}% of the swing time" for name in ROBOTS)
     stiff = "; ".join(f"{name} {runs[name, 'drag, shipped']['distance_travelled_m']:.3f} m, "
                       f"{100 * runs[name, 'drag, shipped']['scuff_fraction']:.1f}%" for name in ROBOTS)
-    blocks = {"sim-flat": "\n".join(flat), "sim-settings": "\n".join(settings),
+    first = runs["op3", OP3_WALKS[0][0]]
+    readme = (f"On the free-floating simulated OP3 (`gaitbot walk --sim --robot op3 --distance 2`) the balanced walk "
+              f"travels {_travelled(first)} of {first['distance_planned_m']:.3f} m, "
+              f"{'falling' if first['fell'] else 'without falling'}, {abs(100 * first['lateral_drift_m']):.1f} cm "
+              f"of drift, yaw within {first['max_abs_yaw_deg']:.1f} deg, torso roll and pitch RMS "
+              f"{first['torso_roll_rms_deg']:.2f} and {first['torso_pitch_rms_deg']:.2f} deg.")
+    blocks = {"sim-op3-summary": readme, "sim-op3": op3_table(runs), "sim-flat": "\n".join(flat), "sim-settings": "\n".join(settings),
               "sim-toe-drag": (f"With the swing clearance turned off (`--clearance 0`), at factory gains, of "
                                f"{DISTANCE} m: {drag}. With the shipped stiff servos: {stiff}.")}
     return "\n".join(f"<!-- figure {k} -->\n{v}\n<!-- /figure -->" for k, v in blocks.items())
@@ -104,7 +139,10 @@ def main(argv=None) -> int:
     if args.markdown:
         print(markdown(runs))
         return 0
+    print(op3_table(runs))
     for (name, key), r in runs.items():
+        if name == "op3":
+            continue
         print(f"{name:14s} {key:14s} planned {r['distance_planned_m']:.3f} m, travelled {_travelled(r)}, "
               f"fell {r['fell']} {r['fell_at_s']}, scuff {100 * r['scuff_fraction']:.1f}%, slip "
               f"{1000 * r['max_slip_m']:.1f} mm, torque {r['max_torque_fraction']:.2f}, tracking "

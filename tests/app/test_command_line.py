@@ -22,14 +22,17 @@ def walk_csv(tmp_path_factory):
 
 
 @pytest.mark.parametrize("command", ["plan", "generate -o x.csv", "walk"])
-def test_no_source_of_steps_shows_the_command_usage(capsys, command):
+def test_no_source_of_steps_is_one_line_pointing_to_the_command_help(capsys, command):
+    """Bad input is one line (the faults issue): the command's own error and its own --help, not the top
+    level's list of commands and not a usage block."""
     with pytest.raises(SystemExit) as exit_info:
         run_cli(capsys, *command.split())
     err = capsys.readouterr().err
     assert exit_info.value.code == 2
     name = command.split()[0]
-    assert f"usage: gaitbot {name} " in err  # the command's own usage, not the top level's list of commands
-    assert f"gaitbot {name}: error: give --steps, --distance or --terrain" in err
+    assert err.count("\n") == 1
+    assert err.startswith(f"gaitbot {name}: error: give --steps, --distance or --terrain")
+    assert f"(see gaitbot {name} --help)" in err
 
 
 def test_the_demo_walk_says_what_it_walks(capsys):

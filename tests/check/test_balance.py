@@ -70,7 +70,7 @@ def test_the_cli_check_fails_a_tipping_file_and_walk_refuses_it_before_anything_
     out = capsys.readouterr().out
     assert "tip backwards" in out and "balance:" in out
     record = tmp_path / "run.jsonl"
-    assert main(["walk", "--dry-run", "--robot", "op3", "--trajectory", str(path), "--record", str(record)]) == 2
+    assert main(["walk", "--dry-run", "--robot", "op3", "--trajectory", str(path), "--record", str(record)]) == 1
     err = capsys.readouterr().err
     assert "refused before anything moved" in err and "tip backwards" in err
     assert not record.exists() or "goal" not in record.read_text()

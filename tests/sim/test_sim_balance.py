@@ -1,6 +1,6 @@
 """The free-floating 3D simulation: the balanced op3 walk meets issue 15's targets through the real CLI
 (``gaitbot walk --sim``: the goals as servo ticks through the SDK packets), a pitch-only robot without
-the boom falls and says so (exit 1), the boom reproduces today's figures, a push is survived, and the
+the boom is refused (and would fall), the boom reproduces today's figures, a push is survived, and the
 robustness subset (tools/robustness.py --quick) passes. Also: the 3D model's kinematics and masses are
 the gait's to 1e-9."""
 
@@ -126,14 +126,30 @@ def test_a_sideways_push_mid_step_is_survived(capsys):
     assert 1 <= push["step"] <= 21
 
 
-def test_a_pitch_only_robot_without_the_boom_falls_and_exits_1(capsys):
+def test_a_pitch_only_robot_free_standing_is_refused_and_would_fall_sideways(tmp_path, capsys):
+    """A robot without hip and ankle roll cannot shift its weight over the stance foot. Its config without
+    ``boom = true``: the walk is refused before anything moves (exit 1, the balance check names the ZMP),
+    and the same walk played anyway on the free-floating model falls sideways, what the refusal is for."""
+    sys.path.insert(0, str(REPO_ROOT / "tools"))
+    import robustness
+
+    from gaitbot.app.walks import trajectory_for_robot
+    from gaitbot.robot.config import load_robot_config
+
+    text = (REPO_ROOT / "config" / "xl430-biped.toml").read_text()
+    assert "boom = true" in text
+    path = tmp_path / "free-standing.toml"
+    path.write_text(text.replace("boom = true", "boom = false"))
     capsys.readouterr()
-    assert main(["walk", "--sim", "--robot", "xl430-biped", "--distance", "0.5"]) == 1
-    out = capsys.readouterr().out
-    assert "The robot fell sideways" in out and "free-floating" in out
-    code, r = sim(capsys, "--robot", "xl430-biped", "--distance", "0.5")
-    assert code == 1 and r["fell"] is True and r["fall_direction"].startswith("sideways")
-    assert 0.5 < r["fell_at_s"] < 4.0
+    assert main(["walk", "--sim", "--robot", str(path), "--distance", "0.5"]) == 1
+    err = capsys.readouterr().err
+    assert "walk refused before anything moved" in err and "zmp" in err
+    config = load_robot_config(path)
+    args = robustness.plan_arguments(["--distance", "0.5"], robot=str(path))
+    _, walker, planned = trajectory_for_robot(args)
+    row = robustness.play_ours(config, walker, planned, planned, error_deg=config.servo.full_torque_error_deg)
+    assert row["fell"] and row["fall_direction"].startswith("sideways"), row
+    assert 0.5 < row["fell_at_s"] < 4.0
 
 
 @pytest.mark.parametrize("name", sorted(TODAY_BOOM_M))
@@ -155,7 +171,8 @@ def test_op3_on_the_boom_for_comparison(capsys):
     (["--push", "0.7", "--boom"], "--push: a sideways push needs a free-floating torso"),
     (["--push", "nan"], "--push must be a non-zero impulse"),
     (["--dry-run", "--push", "0.7"], "--push: only with --sim"),
-    (["--dry-run", "--boom"], "--boom: only with --sim"),
+    (["--dry-run", "--free-pitch"], "--free-pitch: only with --sim"),
+    (["--push", "1e9"], "--push must be a non-zero impulse of at most"),
 ])
 def test_what_a_push_or_boom_cannot_do_is_one_line_and_exit_2(args, message, capsys):
     capsys.readouterr()
