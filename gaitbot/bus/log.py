@@ -239,18 +239,23 @@ def is_bus_log(path: str | Path) -> bool:
         return False
 
 
+def _unreadable(path: Path, exc: OSError | UnicodeDecodeError) -> RecordingError:
+    """Why a bus log cannot be read, in one line (exit 2)."""
+    if isinstance(exc, FileNotFoundError):
+        return RecordingError(f"{path}: no such file")
+    if isinstance(exc, UnicodeDecodeError):
+        return RecordingError(f"{path}: cannot read (not UTF-8 text: {exc.reason} at byte {exc.start})")
+    return RecordingError(f"{path}: cannot read ({exc.strerror or exc})")
+
+
 def read_log(path: str | Path, *, allow_partial_last_line: bool = False) -> BusLog:
     """The header and every packet line of a bus log. Raises RecordingError (exit 2) for a file that
     cannot be read as a bus log; bad bytes inside a packet are left for the checks."""
     path = Path(path)
     try:
         text = read_user_file(path).decode("utf-8")
-    except FileNotFoundError:
-        raise RecordingError(f"{path}: no such file") from None
-    except UnicodeDecodeError as exc:
-        raise RecordingError(f"{path}: cannot read (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
-    except OSError as exc:
-        raise RecordingError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise _unreadable(path, exc) from None
     lines = text.split("\n")
     dropped = None
     if lines and lines[-1] == "":
@@ -276,12 +281,8 @@ def read_header(path: str | Path) -> dict:
             read_user_file(path, 0)  # the reason: missing, a directory, a FIFO or a device
         with open(path, encoding="utf-8") as f:
             first = f.readline(MAX_HEADER_CHARS)
-    except FileNotFoundError:
-        raise RecordingError(f"{path}: no such file") from None
-    except UnicodeDecodeError as exc:
-        raise RecordingError(f"{path}: cannot read (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
-    except OSError as exc:
-        raise RecordingError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise _unreadable(path, exc) from None
     if not first.strip():
         raise RecordingError(f"{path}:1: empty file, no {LOG_FORMAT} header")
     return _header(path, first)

@@ -143,6 +143,25 @@ def _leg(side: str, y_m: float, g: Geometry, config: RobotConfig, drives: dict[s
     </body>"""
 
 
+def world_head(timestep: float) -> str:
+    """The MJCF both models share up to the robot: solver options, the contact defaults and the floor."""
+    return f"""  <compiler angle="degree" autolimits="true"/>
+  <option timestep="{_f(timestep)}" integrator="implicitfast" cone="elliptic" impratio="{_f(IMPRATIO)}"/>
+  <visual><global offwidth="640" offheight="480"/></visual>
+  <default>
+    <geom contype="2" conaffinity="1" condim="3" friction="{_f(FLOOR_FRICTION, 0.005, 0.0001)}"
+          solref="{_f(*CONTACT_SOLREF)}" solimp="{_f(*CONTACT_SOLIMP)}"/>
+  </default>
+  <asset>
+    <texture name="grid" type="2d" builtin="checker" rgb1="0.92 0.92 0.92" rgb2="0.78 0.8 0.84" width="256" height="256"/>
+    <material name="grid" texture="grid" texrepeat="1 1" texuniform="true"/>
+  </asset>
+  <worldbody>
+    <light pos="0 -2 3" dir="0 1 -1.5" directional="true"/>
+    <geom name="floor" type="plane" size="0 0 0.05" material="grid" contype="1" conaffinity="2"/>
+"""
+
+
 def build_mjcf(config: RobotConfig, rate_hz: float, free_pitch: bool = False) -> str:
     """The MJCF document of the robot standing straight with its soles on the floor at z = 0.
 
@@ -163,21 +182,7 @@ def build_mjcf(config: RobotConfig, rate_hz: float, free_pitch: bool = False) ->
     sensors = "\n    ".join(f'<touch name="touch_{side}" site="touch_{side}"/>' for side in SIDES)
     legs = "".join(_leg(side, y, g, config, drives) for side, y in zip(SIDES, (g.hip_width_m / 2, -g.hip_width_m / 2)))
     return f"""<mujoco model="{config.name}">
-  <compiler angle="degree" autolimits="true"/>
-  <option timestep="{_f(timestep)}" integrator="implicitfast" cone="elliptic" impratio="{_f(IMPRATIO)}"/>
-  <visual><global offwidth="640" offheight="480"/></visual>
-  <default>
-    <geom contype="2" conaffinity="1" condim="3" friction="{_f(FLOOR_FRICTION, 0.005, 0.0001)}"
-          solref="{_f(*CONTACT_SOLREF)}" solimp="{_f(*CONTACT_SOLIMP)}"/>
-  </default>
-  <asset>
-    <texture name="grid" type="2d" builtin="checker" rgb1="0.92 0.92 0.92" rgb2="0.78 0.8 0.84" width="256" height="256"/>
-    <material name="grid" texture="grid" texrepeat="1 1" texuniform="true"/>
-  </asset>
-  <worldbody>
-    <light pos="0 -2 3" dir="0 1 -1.5" directional="true"/>
-    <geom name="floor" type="plane" size="0 0 0.05" material="grid" contype="1" conaffinity="2"/>
-    <body name="torso" pos="0 0 {_f(leg_length + g.ankle_height_m)}">
+{world_head(timestep)}    <body name="torso" pos="0 0 {_f(leg_length + g.ankle_height_m)}">
       <joint name="boom_x" type="slide" axis="1 0 0"/>
       <joint name="boom_z" type="slide" axis="0 0 1"/>
       {pitch}

@@ -25,8 +25,7 @@ import numpy as np
 from gaitbot.gait.body import LEG_LINKS, SIDE_SIGN
 from gaitbot.gait.joints import LEG_JOINT_KINDS, SIDES
 from gaitbot.robot.config import RobotConfig
-from gaitbot.sim.model import (CONTACT_SOLIMP, CONTACT_SOLREF, FLOOR_FRICTION, IMPRATIO, LEG_RGBA, SOLE_THICKNESS_M,
-                               JointDrive, substeps_per_frame)
+from gaitbot.sim.model import LEG_RGBA, SOLE_THICKNESS_M, JointDrive, substeps_per_frame, world_head
 
 SUPPORTS = ("free", "boom", "boom-pitch")
 MIN_MOVING_LINK_KG = 1e-4  # MuJoCo needs mass on a body that moves; a massless link of a pitch-only leg gets this
@@ -119,21 +118,7 @@ def build_mjcf_3d(config: RobotConfig, drives: tuple[JointDrive, ...], rate_hz: 
     sensors = "\n    ".join(f'<touch name="touch_{side}" site="touch_{side}"/>' for side in SIDES)
     legs = "".join(_leg(config, side, by_name) for side in SIDES)
     return f"""<mujoco model="{config.name}">
-  <compiler angle="degree" autolimits="true"/>
-  <option timestep="{_f(timestep)}" integrator="implicitfast" cone="elliptic" impratio="{_f(IMPRATIO)}"/>
-  <visual><global offwidth="640" offheight="480"/></visual>
-  <default>
-    <geom contype="2" conaffinity="1" condim="3" friction="{_f(FLOOR_FRICTION, 0.005, 0.0001)}"
-          solref="{_f(*CONTACT_SOLREF)}" solimp="{_f(*CONTACT_SOLIMP)}"/>
-  </default>
-  <asset>
-    <texture name="grid" type="2d" builtin="checker" rgb1="0.92 0.92 0.92" rgb2="0.78 0.8 0.84" width="256" height="256"/>
-    <material name="grid" texture="grid" texrepeat="1 1" texuniform="true"/>
-  </asset>
-  <worldbody>
-    <light pos="0 -2 3" dir="0 1 -1.5" directional="true"/>
-    <geom name="floor" type="plane" size="0 0 0.05" material="grid" contype="1" conaffinity="2"/>
-    <body name="torso" pos="0 0 {_f(g.standing_root_height_m)}">
+{world_head(timestep)}    <body name="torso" pos="0 0 {_f(g.standing_root_height_m)}">
       {root_joints}
       {_inertial(config.body.torso, True)}
       <geom name="torso" type="box" pos="0 0 {_f(torso_centre_z)}" size="{_f(*torso_half)}" mass="0" rgba="0.3 0.45 0.7 1"/>
