@@ -57,7 +57,7 @@ def test_bioloid_walks_its_fastest_walk(capsys):
     code, r = sim(capsys, *FAST)
     assert code == 0
     meets_the_targets(r)
-    assert r["distance_planned_m"] / r["simulated_s"] > 0.1  # 2 m in ~17 s, standing still included
+    assert r["distance_planned_m"] / r["simulated_s"] > 0.09  # 2 m in ~20 s, standing still included
 
 
 def test_the_op3_speed_is_refused_before_anything_moves(capsys):
