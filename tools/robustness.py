@@ -3,6 +3,7 @@
     python tools/robustness.py            # the whole table (docs/balance.md quotes it), about 2 minutes
     python tools/robustness.py --quick    # the subset tests/sim/test_sim_balance.py runs
     python tools/robustness.py --json     # one JSON object per row
+    python tools/robustness.py --robot bioloid   # the same for the BIOLOID Type A (its own walks, no Menagerie)
 
 Every walk is planned once, from the shipped config/op3.toml, exactly as ``gaitbot generate`` plans it
 (gaitbot.app.walks), then played open loop, each frame's goals held 1/60 s, on:
@@ -18,6 +19,12 @@ Pass: issue 15's targets (no fall, travelled within 10% of the plan, lateral dri
 under 5 deg, torso roll and pitch RMS under 2 deg); for pushes, no fall. Goals here are floats (the
 CLI's walk --sim sends them as servo ticks through the bus: figures differ in the last digit).
 Exit status 1 if any row fails.
+
+``--robot bioloid`` (config/bioloid.toml, ROBOTIS BIOLOID Premium Type A, 12 AX-12A): the same rows with
+its own walks (BIOLOID_WALKS: steps scaled by its leg, 0.7 of the op3's), servos at the compliance slope
+gaitbot writes and at the factory slope 32 (9.4 deg), the stiffness rows at the slopes in between, and
+pushes of 0.34 N s (the op3's 0.7 N s scaled by mass: the same velocity change); there is no other
+author's model of it to play (no Menagerie rows).
 """
 
 from __future__ import annotations
@@ -26,7 +33,7 @@ import argparse
 import json
 import sys
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -46,6 +53,42 @@ WALKS = {
     "2 m asymmetric 5/3 cm": ["--steps", ",".join(["0.05,0.03"] * 25)],
     "0.2 m/s (cycle 0.8, 8 cm)": ["--distance", "2", "--cycle", "0.8", "--max-step", "0.08"],
 }
+#: The bioloid's walks: the op3's scaled by leg length (0.149 / 0.220 m, about 0.7): varied 3 +- 0.7 cm,
+#: asymmetric 3.5 / 2 cm (its max_step_m and 0.6 of it, as the op3's 5 / 3 cm), and its fastest walk
+#: that meets the targets (docs/balance.md, "The bioloid").
+BIOLOID_WALKS = {
+    "2 m": ["--distance", "2"],
+    "2 m varied (3 +- 0.7 cm)": ["--distance", "2", "--max-step", "0.03", "--perturb", "0.007", "--seed", "1"],
+    "2 m asymmetric 3.5/2 cm": ["--steps", ",".join(["0.035,0.02"] * 36)],
+    "0.125 m/s (cycle 0.8, 5 cm)": ["--distance", "2", "--cycle", "0.8", "--max-step", "0.05"],
+}
+AX_SLOPE_DEG = 300 / 1023  # AX-12A compliance slope unit (gaitbot.servos.models): slope 32 = 9.38 deg
+
+
+@dataclass(frozen=True)
+class RobotRows:
+    """What the table plays for one robot: its walks, the stiffness gaitbot writes and the factory's, the
+    stiffness rows' errors, the push impulses (N s) and whether Menagerie's model of it exists."""
+
+    walks: dict
+    written_deg: float
+    factory_deg: float
+    stiffness_deg: tuple
+    push_n_s: float
+    menagerie: bool
+
+
+def robot_rows(robot: str) -> RobotRows:
+    if robot == "op3":
+        return RobotRows(WALKS, WRITTEN_DEG, FACTORY_DEG, (8.0, 10.0, FACTORY_DEG), 0.7, True)
+    if robot == "bioloid":
+        from gaitbot.robot.balanced_walk import full_torque_error_deg
+
+        config = load_robot_config(resolve_config("bioloid"))
+        written = full_torque_error_deg(config, "knee_pitch_left")  # the slope step the register obtains
+        stiffness = tuple(s * AX_SLOPE_DEG for s in (4, 8, 16, 32) if s * AX_SLOPE_DEG > written * 1.01)
+        return RobotRows(BIOLOID_WALKS, written, 32 * AX_SLOPE_DEG, stiffness, 0.34, False)
+    raise SystemExit(f"robustness.py: no table for robot {robot!r} (op3, bioloid)")
 
 
 def plan_arguments(args: list[str], robot: str = "op3") -> argparse.Namespace:
@@ -62,8 +105,8 @@ def plan_arguments(args: list[str], robot: str = "op3") -> argparse.Namespace:
     return parsed
 
 
-def plan(args: list[str]):
-    _, walker, planned = trajectory_for_robot(plan_arguments(args))
+def plan(args: list[str], robot: str = "op3"):
+    _, walker, planned = trajectory_for_robot(plan_arguments(args, robot=robot))
     return walker, planned, walker.walk.trajectory(goals=True)
 
 
@@ -127,22 +170,27 @@ def passes(row: dict) -> bool:
             and row["yaw_deg"] < 5.0 and row["roll_rms_deg"] < 2.0 and row["pitch_rms_deg"] < 2.0)
 
 
-def rows(quick: bool):
+def rows(quick: bool, robot_name: str = "op3"):
     """(group, walk, robot, push N s, thunk) for every row of the table."""
-    config = load_robot_config(resolve_config("op3"))
-    plans = {name: plan(args) for name, args in WALKS.items()}
-    ours_ff = ("ours, gain written (6 deg) + sag feedforward", lambda w, p, g, **kw: play_ours(config, w, p, g, WRITTEN_DEG, **kw), True)
-    ours_factory = ("ours, factory gain (12.4 deg), plain angles", lambda w, p, g, **kw: play_ours(config, w, p, p, FACTORY_DEG, **kw), False)
+    spec = robot_rows(robot_name)
+    written, factory = spec.written_deg, spec.factory_deg
+    config = load_robot_config(resolve_config(robot_name))
+    plans = {name: plan(args, robot_name) for name, args in spec.walks.items()}
+    ours_ff = (f"ours, gain written ({written:.3g} deg) + sag feedforward",
+               lambda w, p, g, **kw: play_ours(config, w, p, g, written, **kw), True)
+    ours_factory = (f"ours, factory gain ({factory:.3g} deg), plain angles",
+                    lambda w, p, g, **kw: play_ours(config, w, p, p, factory, **kw), False)
     menagerie = ("Menagerie OP3, plain angles", lambda w, p, g, **kw: play_menagerie(w, p, **kw), False)
+    players = (ours_ff, ours_factory, menagerie) if spec.menagerie else (ours_ff, ours_factory)
     out = []
-    walks = ["2 m"] if quick else list(WALKS)
+    walks = ["2 m"] if quick else list(spec.walks)
     for walk in walks:
-        for robot, play, _ in (ours_ff, ours_factory, menagerie):
+        for robot, play, _ in players:
             out.append(("walks", walk, robot, 0.0, lambda play=play, walk=walk: play(*plans[walk])))
     errors = ["mass +20%", "CoM heights -20%", "friction 0.6"] if quick else \
         ["mass +20%", "mass -20%", "CoM heights +20%", "CoM heights -20%", "friction 0.6"]
     for kind in errors:
-        for error_deg, label, goals in ((WRITTEN_DEG, ours_ff[0], True), (FACTORY_DEG, ours_factory[0], False)):
+        for error_deg, label, goals in ((written, ours_ff[0], True), (factory, ours_factory[0], False)):
             if quick and kind != "friction 0.6" and goals != (kind == "mass +20%"):
                 continue
 
@@ -153,15 +201,16 @@ def rows(quick: bool):
                 return play_ours(perturbed(config, kind), w, p, g if goals else p, error_deg)
             out.append(("model errors (2 m)", kind, label, 0.0, thunk))
     if not quick:
-        out.append(("model errors (2 m)", "friction 0.6", menagerie[0], 0.0,
-                    lambda: play_menagerie(*plans["2 m"][:2], friction=0.6)))
-        for error_deg in (8.0, 10.0, FACTORY_DEG):
-            out.append(("stiffness (2 m)", f"servos at {error_deg:.3g} deg", "ours + sag feedforward for 6 deg", 0.0,
-                        lambda e=error_deg: play_ours(config, *plans["2 m"], e)))
-    pushes = (0.7,) if quick else (0.7, -0.7)
+        if spec.menagerie:
+            out.append(("model errors (2 m)", "friction 0.6", menagerie[0], 0.0,
+                        lambda: play_menagerie(*plans["2 m"][:2], friction=0.6)))
+        for error_deg in spec.stiffness_deg:
+            out.append(("stiffness (2 m)", f"servos at {error_deg:.3g} deg", f"ours + sag feedforward for {written:.3g} deg",
+                        0.0, lambda e=error_deg: play_ours(config, *plans["2 m"], e)))
+    pushes = (spec.push_n_s,) if quick else (spec.push_n_s, -spec.push_n_s)
     for impulse in pushes:
-        for robot, play, _ in ((ours_ff, ours_factory, menagerie)[:1] if quick else (ours_ff, ours_factory, menagerie)):
-            out.append(("push mid-step (2 m)", f"{impulse:+.1f} N s", robot, impulse,
+        for robot, play, _ in (players[:1] if quick else players):
+            out.append(("push mid-step (2 m)", f"{impulse:+.2g} N s", robot, impulse,
                         lambda play=play, impulse=impulse: play(*plans["2 m"], push_n_s=impulse)))
     return out
 
@@ -170,6 +219,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the subset the tests run")
     parser.add_argument("--json", action="store_true", help="one JSON object per row")
+    parser.add_argument("--robot", default="op3", choices=("op3", "bioloid"), help="whose table (default op3)")
     args = parser.parse_args(argv)
     import_mujoco()
     start = time.perf_counter()
@@ -177,7 +227,7 @@ def main(argv=None) -> int:
     if not args.json:
         print("| group | walk / error | robot | pass | fell | travelled | drift cm | max yaw deg | roll RMS deg | pitch RMS deg |")
         print("|---|---|---|---|---|---|---|---|---|---|")
-    for group, walk, robot, push, thunk in rows(args.quick):
+    for group, walk, robot, push, thunk in rows(args.quick, args.robot):
         row = dict(group=group, walk=walk, robot=robot, push=push, **thunk())
         row["pass"] = passes(row)
         results.append(row)

@@ -5,7 +5,7 @@ boom, and what the two walking settings of their configs are worth (the sim extr
     python tools/sim_figures.py --markdown    # the figures of docs/simulation.md (tools/figures.py)
 
 Every figure is a ``gaitbot walk --sim --json`` run through the command line itself: the op3 walks of
-OP3_WALKS (issue 15's targets); per pitch-only robot, 1 m with the
+OP3_WALKS and the bioloid's of BIOLOID_WALKS (issue 15's targets); per pitch-only robot, 1 m with the
 pitch held and with it free; the same walks with the ankle at the heel (``heel_back_m = 0``), at the servos'
 factory gains (no ``[servo] full_torque_error_deg``), and both; and toe drag (``--clearance 0``) at factory
 and at the shipped gains. The simulation is deterministic: a run gives the same figures on every machine.
@@ -40,6 +40,22 @@ OP3_WALKS = (
     ("`--distance 2 --push 0.7`", ["--distance", "2", "--push", "0.7"]),
     ("`--distance 2 --push -0.7`", ["--distance", "2", "--push", "-0.7"]),
 )
+#: The balanced bioloid walks of docs/simulation.md: the op3's scaled to its legs (0.149 / 0.220 m), its
+#: fastest walk within the AX-12A's 300 deg/s, pushes of the op3's velocity change (0.34 N s), the largest
+#: it survives both ways (0.65) and the op3's 0.7 N s (docs/balance.md, "The bioloid").
+BIOLOID_WALKS = (
+    ("`--distance 2`", ["--distance", "2"]),
+    ("`--distance 2 --max-step 0.03 --perturb 0.007 --seed 1` (varied)",
+     ["--distance", "2", "--max-step", "0.03", "--perturb", "0.007", "--seed", "1"]),
+    ("`--steps 0.035,0.02,...` (36 pairs, asymmetric)", ["--steps", ",".join(["0.035,0.02"] * 36)]),
+    ("`--distance 2 --cycle 0.8 --max-step 0.05` (0.125 m/s)", ["--distance", "2", "--cycle", "0.8", "--max-step", "0.05"]),
+    ("`--distance 2 --push 0.34`", ["--distance", "2", "--push", "0.34"]),
+    ("`--distance 2 --push -0.34`", ["--distance", "2", "--push", "-0.34"]),
+    ("`--distance 2 --push 0.65`", ["--distance", "2", "--push", "0.65"]),
+    ("`--distance 2 --push -0.65`", ["--distance", "2", "--push", "-0.65"]),
+    ("`--distance 2 --push 0.7`", ["--distance", "2", "--push", "0.7"]),
+    ("`--distance 2 --push -0.7`", ["--distance", "2", "--push", "-0.7"]),
+)
 
 
 def variant(name: str, folder: Path, ankle_at_heel: bool, factory_gains: bool) -> str:
@@ -63,11 +79,14 @@ def sim(*args: str) -> dict:
 
 def measure() -> dict:
     runs = {}
-    total = 7 * len(ROBOTS) + len(OP3_WALKS)
+    total = 7 * len(ROBOTS) + len(OP3_WALKS) + len(BIOLOID_WALKS)
     with tempfile.TemporaryDirectory() as tmp, progress("simulated walks", total=total, unit="walk") as bar:
         folder = Path(tmp)
         for label, args in OP3_WALKS:
             runs["op3", label] = sim("--robot", "op3", *args)
+            bar.update(1)
+        for label, args in BIOLOID_WALKS:
+            runs["bioloid", label] = sim("--robot", "bioloid", *args)
             bar.update(1)
         for name in ROBOTS:
             def run(key, *args):
@@ -87,11 +106,11 @@ def _travelled(r: dict) -> str:
     return f"{r['distance_travelled_m']:.3f} ({100 * r['distance_travelled_m'] / r['distance_planned_m']:.0f}%)"
 
 
-def op3_table(runs: dict) -> str:
+def op3_table(runs: dict, robot: str = "op3", walks=OP3_WALKS) -> str:
     rows = ["| ARGS | travelled of planned m | drift cm | yaw end / max deg | roll RMS / max deg | "
             "pitch RMS / max deg | max foothold error mm | simulated s |", "|---|---|---|---|---|---|---|---|"]
-    for label, _ in OP3_WALKS:
-        r = runs["op3", label]
+    for label, _ in walks:
+        r = runs[robot, label]
         fell = f" FELL at {r['fell_at_s']:.2f} s" if r["fell"] else ""
         rows.append(f"| {label} | {_travelled(r)} of {r['distance_planned_m']:.3f}{fell} | "
                     f"{100 * r['lateral_drift_m']:.1f} | {r['yaw_deg']:.1f} / {r['max_abs_yaw_deg']:.1f} | "
@@ -125,7 +144,8 @@ def markdown(runs: dict) -> str:
               f"{'falling' if first['fell'] else 'without falling'}, {abs(100 * first['lateral_drift_m']):.1f} cm "
               f"of drift, yaw within {first['max_abs_yaw_deg']:.1f} deg, torso roll and pitch RMS "
               f"{first['torso_roll_rms_deg']:.2f} and {first['torso_pitch_rms_deg']:.2f} deg.")
-    blocks = {"sim-op3-summary": readme, "sim-op3": op3_table(runs), "sim-flat": "\n".join(flat), "sim-settings": "\n".join(settings),
+    blocks = {"sim-op3-summary": readme, "sim-op3": op3_table(runs),
+              "sim-bioloid": op3_table(runs, "bioloid", BIOLOID_WALKS), "sim-flat": "\n".join(flat), "sim-settings": "\n".join(settings),
               "sim-toe-drag": (f"With the swing clearance turned off (`--clearance 0`), at factory gains, of "
                                f"{DISTANCE} m: {drag}. With the shipped stiff servos: {stiff}.")}
     return "\n".join(f"<!-- figure {k} -->\n{v}\n<!-- /figure -->" for k, v in blocks.items())
@@ -140,8 +160,9 @@ def main(argv=None) -> int:
         print(markdown(runs))
         return 0
     print(op3_table(runs))
+    print(op3_table(runs, "bioloid", BIOLOID_WALKS))
     for (name, key), r in runs.items():
-        if name == "op3":
+        if name in ("op3", "bioloid"):
             continue
         print(f"{name:14s} {key:14s} planned {r['distance_planned_m']:.3f} m, travelled {_travelled(r)}, "
               f"fell {r['fell']} {r['fell_at_s']}, scuff {100 * r['scuff_fraction']:.1f}%, slip "
