@@ -215,34 +215,57 @@ def rows(quick: bool, robot_name: str = "op3"):
     return out
 
 
+HEADER = ("| group | walk / error | robot | pass | fell | travelled | drift cm | max yaw deg | roll RMS deg | "
+          "pitch RMS deg |\n|---|---|---|---|---|---|---|---|---|---|")
+
+
+def table_row(row: dict) -> str:
+    """One row of the table; a walk that fell shows its fall alone (a tumbling body's figures are chaotic)."""
+    head = f"| {row['group']} | {row['walk']} | {row['robot']} | {'yes' if row['pass'] else '**no**'} | "
+    if row["fell"]:
+        return head + f"{row['fell_at_s']:.1f} s {row['fall_direction']} | - | - | - | - | - |"
+    return head + (f"- | {100 * row['travel']:.0f}% | {100 * row['drift_m']:+.1f} | {row['yaw_deg']:.1f} | "
+                   f"{row['roll_rms_deg']:.2f} | {row['pitch_rms_deg']:.2f} |")
+
+
+def measure(quick: bool, robot_name: str, on_row=None) -> list[dict]:
+    results = []
+    for group, walk, robot, push, thunk in rows(quick, robot_name):
+        row = dict(group=group, walk=walk, robot=robot, push=push, **thunk())
+        row["pass"] = passes(row)
+        results.append(row)
+        if on_row is not None:
+            on_row(row)
+    return results
+
+
+def summary(results: list[dict]) -> str:
+    return f"{sum(r['pass'] for r in results)}/{len(results)} pass, {sum(r['fell'] for r in results)} falls."
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the subset the tests run")
     parser.add_argument("--json", action="store_true", help="one JSON object per row")
     parser.add_argument("--robot", default="op3", choices=("op3", "bioloid"), help="whose table (default op3)")
+    parser.add_argument("--markdown", action="store_true",
+                        help="both robots' whole tables as the figures of docs/balance.md (tools/figures.py)")
     args = parser.parse_args(argv)
     import_mujoco()
+    if args.markdown:
+        for name in ("op3", "bioloid"):
+            results = measure(False, name)
+            body = "\n".join([HEADER, *map(table_row, results), "", summary(results)])
+            print(f"<!-- figure robustness-{name} -->\n{body}\n<!-- /figure -->")
+        return 0
     start = time.perf_counter()
-    results = []
     if not args.json:
-        print("| group | walk / error | robot | pass | fell | travelled | drift cm | max yaw deg | roll RMS deg | pitch RMS deg |")
-        print("|---|---|---|---|---|---|---|---|---|---|")
-    for group, walk, robot, push, thunk in rows(args.quick, args.robot):
-        row = dict(group=group, walk=walk, robot=robot, push=push, **thunk())
-        row["pass"] = passes(row)
-        results.append(row)
-        if args.json:
-            print(json.dumps(row), flush=True)
-        else:
-            fell = f"{row['fell_at_s']:.2f} s {row['fall_direction']}" if row["fell"] else "-"
-            print(f"| {group} | {walk} | {robot} | {'yes' if row['pass'] else '**no**'} | {fell} | "
-                  f"{100 * row['travel']:.0f}% | {100 * row['drift_m']:+.1f} | {row['yaw_deg']:.1f} | "
-                  f"{row['roll_rms_deg']:.2f} | {row['pitch_rms_deg']:.2f} |", flush=True)
-    passed = sum(r["pass"] for r in results)
+        print(HEADER)
+    results = measure(args.quick, args.robot, lambda row: print(json.dumps(row) if args.json else table_row(row),
+                                                                  flush=True))
     if not args.json:
-        print(f"\n{passed}/{len(results)} pass, {sum(r['fell'] for r in results)} falls, "
-              f"{time.perf_counter() - start:.0f} s.")
-    return 0 if passed == len(results) else 1
+        print(f"\n{summary(results)} {time.perf_counter() - start:.0f} s.")
+    return 0 if all(r["pass"] for r in results) else 1
 
 
 if __name__ == "__main__":

@@ -107,12 +107,17 @@ def _travelled(r: dict) -> str:
 
 
 def op3_table(runs: dict, robot: str = "op3", walks=OP3_WALKS) -> str:
+    """The balanced walks of ``robot``; a walk that fell shows its fall's time and way alone (what a body
+    does while it tumbles is chaotic, not a figure of the gait)."""
     rows = ["| ARGS | travelled of planned m | drift cm | yaw end / max deg | roll RMS / max deg | "
             "pitch RMS / max deg | max foothold error mm | simulated s |", "|---|---|---|---|---|---|---|---|"]
     for label, _ in walks:
         r = runs[robot, label]
-        fell = f" FELL at {r['fell_at_s']:.2f} s" if r["fell"] else ""
-        rows.append(f"| {label} | {_travelled(r)} of {r['distance_planned_m']:.3f}{fell} | "
+        if r["fell"]:
+            rows.append(f"| {label} | FELL {r['fall_direction']} at {r['fell_at_s']:.1f} s of "
+                        f"{r['distance_planned_m']:.3f} | - | - | - | - | - | {r['simulated_s']:.1f} |")
+            continue
+        rows.append(f"| {label} | {_travelled(r)} of {r['distance_planned_m']:.3f} | "
                     f"{100 * r['lateral_drift_m']:.1f} | {r['yaw_deg']:.1f} / {r['max_abs_yaw_deg']:.1f} | "
                     f"{r['torso_roll_rms_deg']:.2f} / {r['torso_roll_max_deg']:.1f} | "
                     f"{r['torso_pitch_rms_deg']:.2f} / {r['torso_pitch_max_deg']:.1f} | "

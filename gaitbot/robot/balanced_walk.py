@@ -19,6 +19,7 @@ from gaitbot.gait.balance.walker import (BalancedGaitSettings, BalancedWalk, Bal
                                          walk_of, plan_balanced_walk)
 from gaitbot.gait.joints import LEG_JOINTS
 from gaitbot.robot.config import RobotConfig
+from gaitbot.robot.gains import gain_for_error
 
 
 def balanced_gait_settings(config: RobotConfig, *, cycle_s: float | None = None, rate_hz: float | None = None,
@@ -38,10 +39,12 @@ def _leg_joint(config: RobotConfig, name: str):
 
 
 def full_torque_error_deg(config: RobotConfig, name: str) -> float:
-    """The stiffness a leg servo walks with: the ``[servo]`` setting written to it, else its factory gain's."""
+    """The stiffness a leg servo walks with (deg of error at full torque): what the gain register holds
+    after the ``[servo]`` setting is written (a register holds whole steps: an AX-12A asked for 2 deg gets
+    compliance slope 4, 1.17 deg), else its factory gain's. The sag feedforward divides by this."""
     joint = _leg_joint(config, name)
     if config.servo.full_torque_error_deg is not None:
-        return config.servo.full_torque_error_deg
+        return gain_for_error(joint.model, config.servo.full_torque_error_deg).full_torque_error_deg
     return joint.model.full_torque_error_deg
 
 

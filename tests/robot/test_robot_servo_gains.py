@@ -166,3 +166,24 @@ def test_the_plan_covers_every_servo_held_joints_too():
 def test_without_the_setting_the_plan_is_empty(tmp_path):
     text = re.sub(r"(?m)^\[servo\]\nfull_torque_error_deg = .*\n", "", (CONFIG_DIR / "xl430-biped.toml").read_text())
     assert gain_plan(load_robot_config(write_config(tmp_path, text))) == ()
+
+
+def test_the_sag_feedforward_uses_the_stiffness_the_register_will_hold():
+    """The balanced walk's sag feedforward divides the gravity torque by the servo's stiffness: it must be
+    the stiffness of the gain value written (decoded by the register's own law), not the one asked for
+    (an AX-12A's compliance slope has seven steps; asked for 2 deg it holds 1.17)."""
+    from gaitbot.robot.balanced_walk import full_torque_error_deg
+    from gaitbot.robot.config import load_robot_config, resolve_config
+    from gaitbot.robot.gains import gain_writes
+
+    for name in ("op3", "bioloid"):
+        config = load_robot_config(resolve_config(name))
+        writes = gain_writes(config)
+        for joint in config.joints:
+            if joint.hold_deg is not None:
+                continue
+            gain = joint.model.gain
+            values = [w.value for w in writes if joint.id in w.ids and w.address in gain.addresses]
+            assert values, (name, joint.name)
+            held = max(gain.full_torque_error_deg(v) for v in values)
+            assert full_torque_error_deg(config, joint.name) == pytest.approx(held, rel=1e-12), (name, joint.name)
