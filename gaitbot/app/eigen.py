@@ -14,9 +14,10 @@ trajectory format with the model's joints and the root from foot contact; option
 ``--pose-deg`` (one angle per joint of the model, in its order) at ``--pose-time`` seconds into each
 synthesised cycle (seed 004 eq. 13). The walk starts standing and ends standing: the robot's own
 walker's first steps, the synthesised cycles, its closing step (see gait/eigen/synth.py).
-The walk is checked as ``gaitbot walk`` would check it: one that breaks a limit (a forced pose far
-from the examples' at that time can distort the whole cycle) is still written, for plotting, but a
-warning says so and the exit status is 1.
+The walk is checked as ``gaitbot walk`` would check it, limits and (for a robot not on a boom)
+balance: one that fails (a forced pose far from the examples' at that time can distort the whole
+cycle; an eigen-synthesised walk is not balanced by construction) is still written, for plotting,
+but a warning says so and the exit status is 1.
 """
 
 from __future__ import annotations
@@ -356,7 +357,7 @@ def run_synth(args) -> int:
     report = preflight(config, walk)
     if not report.ok:
         # a forced pose far from the examples' poses at that time can take every other frame far off
-        print(f"warning: {out} breaks {config.name}'s limits ({report.first_error}); gaitbot walk would refuse it. "
+        print(f"warning: {out} fails {config.name}'s check ({report.first_error}); gaitbot walk would refuse it. "
               f"Ask for a pose nearer the examples' at that time, or fewer --components", file=sys.stderr)
         return 1
     return 0
