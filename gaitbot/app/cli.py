@@ -196,8 +196,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="change the step length smoothly to this over the cycles")
     q.add_argument("--cycles", type=int, default=3, help="synthesised cycles (two steps each; default 3)")
     q.add_argument("--components", type=int, metavar="N", help="eigen-motions to use (default: those the model kept)")
-    q.add_argument("--pose-deg", metavar="H,K,A,H,K,A",
-                   help="six joint angles in degrees (hip, knee, ankle left, then right) the motion must pass through")
+    q.add_argument("--pose-deg", metavar="DEG,DEG,...",
+                   help="the pose the motion must pass through: one angle in degrees per joint of the model, in its "
+                   "order (eigen fit prints it; six pitch joints: hip, knee, ankle left, then right); write "
+                   "--pose-deg=-5,... when the first is negative")
     q.add_argument("--pose-time", type=float, metavar="S", help="seconds into each synthesised cycle for --pose-deg")
     _robot_options(q, "robot config (default: the robot the model was fitted for)")
     _leg_options(q, "must be the leg the model was fitted with")

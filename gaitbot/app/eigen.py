@@ -2,16 +2,22 @@
 
 fit: each EXAMPLE is a trajectory file (.npz with heel strikes, or .csv whose heel strikes are
 found from foot contact with the robot's leg); its steady cycles are examples, labelled with the
-walk's step length. Prints the variance explained per pose axis and per eigen-motion (pose.py
-says how many pose axes are kept and why); warns about example files that break the robot's limits.
+walk's step length. The examples are walks of one robot: every file holds the joints the robot walks
+with (gait/eigen/legs.py: the six pitch joints, or all twelve leg joints of a robot whose legs roll)
+and its root stands where that robot's legs put it; a file that differs is refused, naming it and
+what differs (files do not name their robot, so its legs are how it is told). Prints the variance
+explained per pose axis and per eigen-motion (pose.py says how many pose axes are kept and why); warns
+about example files that break the robot's limits.
 
 synth: a walk at ``--step-length`` (optionally going to ``--to-step-length``), written in the
-trajectory format; optionally forced through ``--pose-deg`` at ``--pose-time`` seconds into each
-synthesised cycle (seed 004 eq. 13). The walk starts standing and ends standing: the walker's
-first two steps, the synthesised cycles, the walker's closing step (see gait/eigen/synth.py).
-The walk is checked as ``gaitbot walk`` would check it: one that breaks a limit (a forced pose far
-from the examples' at that time can distort the whole cycle) is still written, for plotting, but a
-warning says so and the exit status is 1.
+trajectory format with the model's joints and the root from foot contact; optionally forced through
+``--pose-deg`` (one angle per joint of the model, in its order) at ``--pose-time`` seconds into each
+synthesised cycle (seed 004 eq. 13). The walk starts standing and ends standing: the robot's own
+walker's first steps, the synthesised cycles, its closing step (see gait/eigen/synth.py).
+The walk is checked as ``gaitbot walk`` would check it, limits and (for a robot not on a boom)
+balance: one that fails (a forced pose far from the examples' at that time can distort the whole
+cycle; an eigen-synthesised walk is not balanced by construction) is still written, for plotting,
+but a warning says so and the exit status is 1.
 """
 
 from __future__ import annotations
@@ -23,15 +29,17 @@ from pathlib import Path
 
 import numpy as np
 
-from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, cycles_from_trajectory, fit_model,
-                                synthesize_walk, walk_label)
-from gaitbot.gait.joints import PITCH_JOINTS
+from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, PlanarLegs, SpatialLegs, WalkEnds,
+                                cycles_from_trajectory, fit_model, synthesize_walk, walk_label)
+from gaitbot.gait.footfall import CONTACT_TOL_FRACTION
 from gaitbot.gait.trajectory import MAX_ANGLE_DEG, Trajectory
 from gaitbot.app.options import UsageError, check_output_path, gait_source, load_robot, write_output
 from gaitbot.app.progress import callback, progress
+from gaitbot.app.walks import balanced_plan
 from gaitbot.check.preflight import preflight
 from gaitbot.errors import UserError
-from gaitbot.robot.walk_settings import walk_settings
+from gaitbot.robot.config import shipped_config_names
+from gaitbot.robot.walk_settings import GaitSource, walk_settings
 
 POSE_TOL_DEG = 0.1
 #: Synthesised cycles one `eigen synth` may ask for (each two steps).
@@ -47,29 +55,93 @@ def run(args) -> int:
 RATE_TOL = 1e-6
 
 
-def load_examples(paths, geometry, robot_rate_hz: float | None = None, config=None, done=lambda n: None):
+#: A file's root may sit this far (median over its frames, as a share of the leg) from where the robot's legs
+#: put it with a sole on the floor: a file written for this robot is within a micrometre (the contact rule
+#: is the walker's own), a shipped robot's walk read with another shipped robot's legs 30 mm or more off.
+LEG_FIT_TOL_FRACTION = 5 * CONTACT_TOL_FRACTION
+
+
+def robot_legs(source: GaitSource, config):
+    """The legs the examples of ``config`` walk on (gait/eigen/legs.py): 3D for a robot whose legs roll,
+    else planar with the leg of ``source`` (the robot's, or --thigh/--shank/--foot)."""
+    if config.is_3d:
+        return SpatialLegs(config.body.geometry)
+    lift = config.geometry.hip_below_root_m if source.robot is not None else 0.0
+    return PlanarLegs(source.geometry, lift)
+
+
+def _joint_list(joints) -> str:
+    return f"{len(joints)} joints ({', '.join(joints)})"
+
+
+def robots_walking_with(joints) -> list[str]:
+    """The shipped robots whose walker moves exactly these joints (a hint for a file of another robot)."""
+    names = []
+    for name in shipped_config_names():
+        try:
+            config = load_robot(name)
+        except UserError:
+            continue
+        if (SpatialLegs.joints if config.is_3d else PlanarLegs.joints) == tuple(joints):
+            names.append(name)
+    return names
+
+
+def _another_robot_hint(joints) -> str:
+    names = robots_walking_with(joints)
+    return f"give the robot that walked them with --robot ({', '.join(names)} walk with these joints)" if names \
+        else "give the robot that walked them with --robot"
+
+
+def check_example(path, trajectory: Trajectory, legs, who: str, first: tuple | None) -> None:
+    """One example file against the first one and the robot's legs: the same joints, the robot's joints, an
+    upright torso, the root where the legs put it; else one line naming the file and what differs."""
+    joints = tuple(trajectory.joints)
+    if first is not None and joints != first[1]:
+        raise UsageError(f"{path} holds {_joint_list(joints)}, {first[0]} holds {_joint_list(first[1])}: the "
+                         f"examples must be walks of one robot, with the same joints")
+    if joints != tuple(legs.joints):
+        raise UsageError(f"{path} holds {_joint_list(joints)}; {who} walks with {_joint_list(legs.joints)}: "
+                         f"were the examples walked by another robot? {_another_robot_hint(joints)}")
+    if trajectory.torso_rpy_rad is not None and np.any(trajectory.torso_rpy_rad != 0):
+        raise UsageError(f"{path} turns the torso (its torso_roll/pitch/yaw columns): eigen-gaits learn walks "
+                         f"with an upright torso, whose root follows from the feet")
+    off = legs.root_height_error_m(trajectory)
+    if off > LEG_FIT_TOL_FRACTION * legs.leg_geometry.leg_length:
+        raise UsageError(f"{path}: its root is {1000 * off:.1f} mm above or below where {who}'s legs put it with a "
+                         f"sole on the floor (median over its frames): were the examples walked by another robot "
+                         f"or leg? {_another_robot_hint(joints)}, or the leg with --thigh/--shank/--foot")
+
+
+def load_examples(paths, legs, robot_rate_hz: float | None = None, config=None, done=lambda n: None,
+                  who: str = "the robot"):
     """Example cycles of every file, each labelled with its walk's step length; and the frame rate
-    (the robot's own when the files were sampled at it). With ``config``, a file that breaks the
-    robot's limits (a recording a hand took too far) is learnt from, with a warning on stderr.
+    (the robot's own when the files were sampled at it). Every file must be a walk of the robot ``who``
+    on ``legs`` (``check_example``) at the first file's frame rate. With ``config``, a file that breaks
+    the robot's limits (a recording a hand took too far) is learnt from, with a warning on stderr.
     ``done(1)`` is called after each file (a progress bar)."""
-    examples, rates = [], []
+    examples, first = [], None
     for path in paths:
         trajectory = Trajectory.load(path)
+        check_example(path, trajectory, legs, who, first)
+        rate = 1.0 / float(np.median(np.diff(trajectory.t_s)))
+        if first is None:
+            first = (path, tuple(trajectory.joints), rate)
+        elif abs(rate - first[2]) > RATE_TOL * max(rate, first[2]):
+            raise UsageError(f"{path} is sampled at {rate:g} Hz, {first[0]} at {first[2]:g} Hz: the example files "
+                             f"have different frame rates")
         if config is not None:
             report = preflight(config, trajectory)
             if not report.ok:
                 print(f"warning: {path}: {report.first_error}; it is learnt from as it is, but walks synthesised "
                       f"near it may break the same limit, and gaitbot walk refuses those", file=sys.stderr)
-        cycles = cycles_from_trajectory(trajectory, geometry, source=str(path))
+        cycles = cycles_from_trajectory(trajectory, legs, source=str(path))
         label = walk_label(cycles)
         examples += [c.__class__(c.angles_rad, c.duration_s, c.right_strike_phase, label, c.source) for c in cycles]
-        rates.append(1.0 / float(np.median(np.diff(trajectory.t_s))))
         done(1)
-    if max(rates) - min(rates) > RATE_TOL * max(rates):
-        raise UsageError(f"the example files have different frame rates ({min(rates):g} to {max(rates):g} Hz)")
-    if robot_rate_hz is not None and abs(rates[0] - robot_rate_hz) <= RATE_TOL * robot_rate_hz:
+    if robot_rate_hz is not None and abs(first[2] - robot_rate_hz) <= RATE_TOL * robot_rate_hz:
         return examples, float(robot_rate_hz)
-    return examples, rates[0]
+    return examples, first[2]
 
 
 def run_fit(args) -> int:
@@ -79,24 +151,37 @@ def run_fit(args) -> int:
     check_output_path(out)
     source = gait_source(args)
     config = load_robot(args.robot, getattr(args, "calibration", None))
+    refuse_leg_options_for_3d(args, config)
+    legs = robot_legs(source, config)
     options = FitOptions(samples=args.samples, basis=args.basis, n_basis=args.n_basis, roughness=args.roughness,
                          pose_variance=args.pose_variance, pose_tolerance_deg=args.pose_tolerance_deg,
                          motion_variance=args.variance, components=args.components, align=args.align,
                          label_degree=args.label_degree)
     with progress("eigen fit: reading examples", total=len(args.examples), unit="file") as bar:
-        examples, rate = load_examples(args.examples, source.geometry, config.gait.rate_hz, source.robot, bar.update)
+        examples, rate = load_examples(args.examples, legs, config.gait.rate_hz, source.robot, bar.update,
+                                       who=config.name if source.robot is not None else "this leg")
     with progress("eigen fit: aligning cycles (DTW)", total=len(examples), unit="cycle") as bar:
         model = fit_model(examples, source.geometry, rate, options, periodic=args.basis == "fourier", robot=config.name,
-                          on_progress=callback(bar))
+                          on_progress=callback(bar), legs=legs)
     write_output(out, model.save)
     labels = sorted(set(np.round(model.labels, 6)))
     print(f"wrote {out}: {len(examples)} example cycles from {len(args.examples)} files, step lengths "
           f"{', '.join(f'{v:g}' for v in labels)} m; for {config.name}, {describe_leg(source.geometry)}")
+    print(f"joints ({len(model.joints)}, the order of --pose-deg): {', '.join(model.joints)}; root from foot "
+          f"contact in {', '.join(model.root_axes)}")
     print_pose_pca(model, options)
     print_variance_table("eigen-motion", model.variance_explained, model.n_components)
     cumulative = np.cumsum(model.variance_explained)
     print(f"{model.n_components} eigen-motions kept ({100 * cumulative[model.n_components - 1]:.2f}% of the variance)")
     return 0
+
+
+def refuse_leg_options_for_3d(args, config) -> None:
+    """--thigh/--shank/--foot change a planar leg; a robot whose legs roll walks on its own body."""
+    given = [f"--{k}" for k in ("thigh", "shank", "foot") if getattr(args, k, None) is not None]
+    if given and config.is_3d:
+        raise UsageError(f"{'/'.join(given)}: {config.name} walks with the balanced walker on its own legs "
+                         f"([geometry] of its config); another leg is for the pitch-only robots")
 
 
 def describe_leg(g) -> str:
@@ -124,10 +209,11 @@ def print_pose_pca(model: EigenGaitModel, options: FitOptions) -> None:
     print(line)
 
 
-def _parse_pose(text: str) -> np.ndarray:
+def _parse_pose(text: str, joints) -> np.ndarray:
+    """--pose-deg: one angle in degrees per joint of the model, in the model's order."""
     items = text.split(",")
-    if len(items) != len(PITCH_JOINTS):
-        raise UsageError(f"--pose-deg: give {len(PITCH_JOINTS)} angles in degrees ({', '.join(PITCH_JOINTS)}), "
+    if len(items) != len(joints):
+        raise UsageError(f"--pose-deg: give {len(joints)} angles in degrees ({', '.join(joints)}), "
                          f"got {len(items)}")
     try:
         values = np.array([float(v) for v in items])
@@ -138,14 +224,17 @@ def _parse_pose(text: str) -> np.ndarray:
     return values
 
 
-def _check_pose_limits(config, pose_deg: np.ndarray) -> None:
-    limits = {j.name: (j.min_deg, j.max_deg) for j in config.joints}
-    for name, value in zip(PITCH_JOINTS, pose_deg):
-        if name in limits:
-            lo, hi = limits[name]
-            if not (lo <= value <= hi):
-                raise UsageError(f"--pose-deg: {name} {value:g} deg is outside its joint limits {lo:g} to {hi:g} deg "
-                                 f"({config.name})")
+def _check_pose_limits(config, joints, pose_deg: np.ndarray) -> None:
+    """Each angle against its joint's limits by name (a held joint: its hold angle)."""
+    limits = {j.name: (j.hold_deg, j.hold_deg) if j.hold_deg is not None else (j.min_deg, j.max_deg)
+              for j in config.joints}
+    for name, value in zip(joints, pose_deg):
+        if name not in limits:
+            raise UsageError(f"--pose-deg: {config.name} has no joint {name}")
+        lo, hi = limits[name]
+        if not (lo <= value <= hi):
+            raise UsageError(f"--pose-deg: {name} {value:g} deg is outside its joint limits {lo:g} to {hi:g} deg "
+                             f"({config.name})")
 
 
 def model_robot(args, model: EigenGaitModel, model_path: str):
@@ -162,13 +251,30 @@ def model_robot(args, model: EigenGaitModel, model_path: str):
     if model.robot and config.name != model.robot:
         raise UsageError(f"{model_path} was fitted for {model.robot}, not {config.name}: fit a model on "
                          f"{config.name}'s walks (gaitbot eigen fit --robot {config.name})")
+    refuse_leg_options_for_3d(args, config)
     source = gait_source(argparse.Namespace(robot=str(config.path), calibration=getattr(args, "calibration", None),
                                             thigh=args.thigh, shank=args.shank, foot=args.foot))
-    if source.geometry != model.geometry:
+    legs = robot_legs(source, config)
+    if tuple(model.joints) != tuple(legs.joints):
+        raise UsageError(f"{model_path} learnt {_joint_list(model.joints)}; {config.name} walks with "
+                         f"{_joint_list(legs.joints)}: fit a model on {config.name}'s walks "
+                         f"(gaitbot eigen fit --robot {config.name})")
+    if source.geometry != model.geometry or getattr(legs, "body_geometry", None) != model.body_geometry:
         raise UsageError(f"{model_path} learnt a {describe_leg(model.geometry)}, this is a "
-                         f"{describe_leg(source.geometry)}: give the model's leg with --thigh/--shank/--foot, or "
-                         f"fit a model on walks of this leg")
-    return config, source
+                         f"{describe_leg(source.geometry)}"
+                         + (" (or its hip, sole or foot width differ)" if source.geometry == model.geometry else "")
+                         + ": give the model's leg with --thigh/--shank/--foot, or fit a model on walks of this leg")
+    return config, source, legs
+
+
+def walk_ends(config, source: GaitSource):
+    """The robot's own walker for a synthesised walk's start and stop (gait/eigen/synth.py WalkEnds): the
+    balanced walker for a robot whose legs roll, with as many steps that its preview, which looks
+    preview_horizon_s ahead, does not see the stop at the first left heel strike (None: the planar walker)."""
+    if not config.is_3d:
+        return None
+    steps = 2 + 2 * math.ceil(config.balance.preview_horizon_s / source.settings.cycle_s)
+    return WalkEnds(lambda step_m, n: balanced_plan(source, [step_m] * n).walk.trajectory(), steps, join_order=2)
 
 
 def run_synth(args) -> int:
@@ -187,7 +293,7 @@ def run_synth(args) -> int:
         if value is not None and not (math.isfinite(value) and value >= 0):
             raise UsageError(f"--{name.replace('_', '-')} must be a finite number of metres, 0 or more, got {value:g}")
     model = EigenGaitModel.load(args.model)
-    config, source = model_robot(args, model, args.model)
+    config, source, legs = model_robot(args, model, args.model)
     settings = walk_settings(config)
     for name in ("step_length", "to_step_length"):
         value = getattr(args, name)
@@ -206,8 +312,8 @@ def run_synth(args) -> int:
             raise UsageError("--pose-deg needs --pose-time (seconds into each synthesised cycle)")
         if args.to_step_length is not None:
             raise UsageError("--pose-deg forces every cycle through one pose: leave out --to-step-length")
-        pose_deg = _parse_pose(args.pose_deg)
-        _check_pose_limits(config, pose_deg)
+        pose_deg = _parse_pose(args.pose_deg, model.joints)
+        _check_pose_limits(config, model.joints, pose_deg)
         duration, warp, _ = model.timing_for(args.step_length)
         if not (0.0 <= args.pose_time < duration):
             raise UsageError(f"--pose-time must be from 0 to below the cycle's {duration:.4g} s, got {args.pose_time:g}")
@@ -217,15 +323,15 @@ def run_synth(args) -> int:
         if worst > POSE_TOL_DEG:
             j = int(np.argmax(np.abs(miss)))
             hint = f"try --components up to {len(model.eigenvalues)}"
-            if model.pose_dims < len(PITCH_JOINTS):
+            if model.pose_dims < len(model.joints):
                 hint += ", or fit with a smaller --pose-tolerance-deg (more pose axes)"
             raise EigenModelError(f"--pose-deg cannot be reached: the model's {len(alpha)} eigen-motions and "
-                                  f"{model.pose_dims} pose axes miss {PITCH_JOINTS[j]} by {worst:.3g} deg ({hint})")
+                                  f"{model.pose_dims} pose axes miss {model.joints[j]} by {worst:.3g} deg ({hint})")
         alphas = [alpha] * (args.cycles + 1)
         pose_report = (args.pose_time, worst)
     try:
         walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,
-                               components=components, alphas=alphas)
+                               components=components, alphas=alphas, ends=walk_ends(config, source), legs=legs)
         with np.errstate(all="ignore"):
             angles_deg = np.degrees(walk.angles_rad)
             finite = all(np.all(np.isfinite(a)) for a in (walk.t_s, angles_deg, walk.root_m))
@@ -251,7 +357,7 @@ def run_synth(args) -> int:
     report = preflight(config, walk)
     if not report.ok:
         # a forced pose far from the examples' poses at that time can take every other frame far off
-        print(f"warning: {out} breaks {config.name}'s limits ({report.first_error}); gaitbot walk would refuse it. "
+        print(f"warning: {out} fails {config.name}'s check ({report.first_error}); gaitbot walk would refuse it. "
               f"Ask for a pose nearer the examples' at that time, or fewer --components", file=sys.stderr)
         return 1
     return 0

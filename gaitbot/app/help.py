@@ -104,7 +104,8 @@ COMMAND_HELP = {
         "fit an eigen-gait model to example walks",
         "Cut each example walk into cycles (left heel strike to left heel strike), align them in time,\n"
         "reduce the poses by PCA, fit each channel with smooth functions and keep the eigen-motions that\n"
-        "explain most of the variance. The model remembers the leg it learnt and the robot it is for.",
+        "explain most of the variance. The examples are walks of one robot (--robot), with the joints it walks\n"
+        "with; the model remembers its joints, the leg it learnt and the robot it is for.",
         ("gaitbot generate --steps 0.03,0.03,0.03,0.03,0.03,0.03 -o ex_0.03.npz",
          "gaitbot generate --steps 0.07,0.07,0.07,0.07,0.07,0.07 -o ex_0.07.npz",
          "gaitbot eigen fit ex_0.03.npz ex_0.07.npz -o model.npz")),
@@ -112,7 +113,8 @@ COMMAND_HELP = {
         "synthesise a walk from an eigen-gait model",
         "Make a walk from the model: at --step-length, changing to --to-step-length, or passing through\n"
         "--pose-deg at --pose-time. It starts and ends standing and is checked like gaitbot walk checks it\n"
-        "(exit 1, with the file written, if it breaks a limit). Only for the robot the model was fitted for.",
+        "(exit 1, with the file written, if it breaks a limit or would tip the robot). Only for the robot the\n"
+        "model was fitted for.",
         ("gaitbot generate --steps 0.03,0.03,0.03,0.03,0.03,0.03 -o ex_0.03.npz",
          "gaitbot generate --steps 0.07,0.07,0.07,0.07,0.07,0.07 -o ex_0.07.npz",
          "gaitbot eigen fit ex_0.03.npz ex_0.07.npz -o model.npz",

@@ -84,8 +84,14 @@ def trajectory_file_walk(args) -> tuple[GaitSource, FileWalk, Trajectory]:
 def build_balanced_walk(args, source: GaitSource) -> BalancedPlan:
     """The balanced walk of a robot whose legs roll: its steps, with --cycle, --rate, --max-step and
     --clearance over the config's [gait]; the servos' speed fitted (gaitbot.gait.balance.speed_fit)."""
-    steps = step_lengths(args, source)
-    longest = max([args.max_step or source.default_step_m or 0.0, *steps])
+    return balanced_plan(source, step_lengths(args, source), args.max_step)
+
+
+def balanced_plan(source: GaitSource, steps, max_step_m: float | None = None) -> BalancedPlan:
+    """The balanced walk of these steps with the source's settings, as ``gaitbot generate`` walks them: the
+    walker's longest step (its swing shapes) is --max-step, else the robot's default step, or the longest
+    step asked for (``gaitbot eigen synth`` starts and stops its walks with the same walks)."""
+    longest = max([max_step_m or source.default_step_m or 0.0, *steps])
     gait = balanced_gait_settings(source.robot, cycle_s=source.settings.cycle_s, rate_hz=source.settings.rate_hz,
                                   max_step_m=longest, clearance_m=source.settings.clearance)
     return plan_balanced(source.robot, steps, gait)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gaitbot.gait.joints import LEG_JOINTS, SIDES
-from gaitbot.gait.kinematics6 import foot_pose
+from gaitbot.gait.kinematics6 import sole_corners
 from gaitbot.gait.mass import GRAVITY_M_S2, MassModel
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.config import RobotConfig
@@ -135,11 +135,7 @@ def balance_trace(config: RobotConfig, trajectory: Trajectory, angles_deg_all: n
         legs = q[:, 6 * i:6 * i + 6]
         masses.extend(model.leg_kg)
         points.append(model.leg_link_coms(side, legs))
-        ankle, rot = foot_pose(g, side, legs)
-        centre = g.sole_centre_in_foot(side)
-        corners = np.array([centre + [dx * g.foot_m / 2, dy * g.foot_width_m / 2, 0.0]
-                            for dx, dy in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
-        soles[side] = world(ankle[:, None, :] + np.einsum("nij,kj->nki", rot, corners))
+        soles[side] = world(sole_corners(g, side, legs))
     m = np.array(masses)
     coms = world(np.concatenate(points, axis=1))  # (N, 13, 3)
     com = np.einsum("k,nkj->nj", m, coms) / m.sum()

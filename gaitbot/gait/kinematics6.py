@@ -140,6 +140,20 @@ def sole_centre(geometry: BodyGeometry, side: str, q_rad) -> np.ndarray:
     return ankle + rot @ geometry.sole_centre_in_foot(side)
 
 
+SOLE_CORNER_SIGNS = ((1, 1), (-1, 1), (-1, -1), (1, -1))
+"""The sole's corners as (forward, left) signs of half its length and width: front left, back left, back
+right, front right (counter-clockwise seen from above)."""
+
+
+def sole_corners(geometry: BodyGeometry, side: str, q_rad) -> np.ndarray:
+    """The sole's four corners (underside; SOLE_CORNER_SIGNS order) in the root frame, (..., 4, 3)."""
+    ankle, rot = foot_pose(geometry, side, q_rad)
+    centre = geometry.sole_centre_in_foot(side)
+    corners = np.array([centre + [dx * geometry.foot_m / 2, dy * geometry.foot_width_m / 2, 0.0]
+                        for dx, dy in SOLE_CORNER_SIGNS])
+    return ankle[..., None, :] + np.einsum("...ij,kj->...ki", rot, corners)
+
+
 class ReachError(ValueError):
     """An ankle target beyond the leg's reach."""
 

@@ -16,11 +16,14 @@ import numpy as np
 
 from gaitbot.gait.footfall import CONTACT_TOL_FRACTION, heel_strikes_from_heights
 from gaitbot.gait.geometry import LegGeometry, leg_points
-from gaitbot.gait.joints import PITCH_JOINTS
+from gaitbot.gait.joints import LEG_JOINT_KINDS, PITCH_JOINTS, SIDES
 from gaitbot.gait.trajectory import HeelStrike, Trajectory
 
 _COLOURS = {"left": "tab:blue", "right": "tab:red"}
 MAX_POSES = 16  # stick figures drawn at most (evenly chosen among the heel strikes)
+#: Which way each joint kind's angle grows (gaitbot/gait/joints.py gives the signs).
+JOINT_SENSE = {"hip_yaw": "toe out", "hip_roll": "abduction", "hip_pitch": "flexion", "knee_pitch": "flexion",
+               "ankle_pitch": "flexion", "ankle_roll": "hip roll's sense"}
 GROUND = "saddlebrown"
 
 
@@ -170,9 +173,37 @@ def trajectory_figure(trajectory: Trajectory, geometry: LegGeometry, clearance: 
     return fig
 
 
+#: A joint whose mean cycle and eigen-motions stay within this many degrees of a constant is not drawn
+#: (a hip yaw a straight walk never turns): the title says so instead.
+STILL_JOINT_DEG = 1e-6
+
+
+def eigen_model_columns(model, mean_deg: np.ndarray, deltas_deg) -> tuple[list, list]:
+    """The columns of the model picture: one per joint kind the model moves (LEG_JOINT_KINDS order), each
+    drawing that joint of both legs, and the joints left out because they do not move ((name, angle))."""
+    kinds, still = [], []
+    for kind in LEG_JOINT_KINDS:
+        names = [f"{kind}_{side}" for side in SIDES if f"{kind}_{side}" in model.joints]
+        if not names:
+            continue
+        moving = False
+        for name in names:
+            c = model.joints.index(name)
+            span = np.ptp(mean_deg[:, c]) + max((np.abs(d[:, c]).max() for d in deltas_deg), default=0.0)
+            if span > STILL_JOINT_DEG:
+                moving = True
+            else:
+                still.append((name, float(mean_deg[0, c])))
+        if moving:
+            kinds.append(kind)
+    return kinds, still
+
+
 def plot_eigen_model(model_path, out: Path, n_show: int = 3) -> None:
-    """Eigen-motions of an eigen-gait model (seed 004 Fig. 3): per eigen-motion, each joint's mean
-    cycle (solid) and mean +- 2 sqrt(eigenvalue) times the eigen-motion (dashed +, dotted -)."""
+    """Eigen-motions of an eigen-gait model (seed 004 Fig. 3): per eigen-motion (rows), each joint's mean
+    cycle (solid) and mean +- 2 sqrt(eigenvalue) times the eigen-motion (dashed +, dotted -), one column
+    per joint kind the model moves, both legs in each. A joint that does not move in any example is left
+    out and named in the title with its angle."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -184,20 +215,28 @@ def plot_eigen_model(model_path, out: Path, n_show: int = 3) -> None:
     k = min(n_show, len(model.eigenvalues))
     s = np.linspace(0.0, 1.0, 201)
     mean = np.degrees(model.poses(s, np.zeros(0)))
-    fig, axes = plt.subplots(k, 3, figsize=(13, 3.2 * k + 0.6), sharex=True, squeeze=False, constrained_layout=True)
+    deltas = [2.0 * np.sqrt(model.eigenvalues[i]) * np.degrees(model.eigen_motion(s, i)) for i in range(k)]
+    kinds, still = eigen_model_columns(model, mean, deltas)
+    columns = max(1, len(kinds))
+    fig, axes = plt.subplots(k, columns, figsize=(13 * max(1.0, columns / 3), 3.2 * k + 0.6), sharex=True,
+                             squeeze=False, constrained_layout=True)
     share = model.variance_explained
     for i in range(k):
-        delta = 2.0 * np.sqrt(model.eigenvalues[i]) * np.degrees(model.eigen_motion(s, i))
-        for j, joint in enumerate(("hip", "knee", "ankle")):
+        delta = deltas[i]
+        for j, kind in enumerate(kinds):
+            joint = kind.replace("_pitch", "").replace("_", " ")
             ax = axes[i, j]
             for side, colour in ((0, "tab:blue"), (1, "tab:red")):
-                c = 3 * side + j
-                ax.plot(100 * s, mean[:, c], color=colour, lw=1.5, label=f"{joint} {'left' if side == 0 else 'right'} mean")
+                name = f"{kind}_{SIDES[side]}"
+                if name not in model.joints:
+                    continue
+                c = model.joints.index(name)
+                ax.plot(100 * s, mean[:, c], color=colour, lw=1.5, label=f"{joint} {SIDES[side]} mean")
                 ax.plot(100 * s, mean[:, c] + delta[:, c], "--", color=colour, lw=1.0)
                 ax.plot(100 * s, mean[:, c] - delta[:, c], ":", color=colour, lw=1.0)
             ax.grid(alpha=0.3)
             if i == 0:
-                ax.set_title(f"{joint} (deg, flexion +)")
+                ax.set_title(f"{joint} (deg, {JOINT_SENSE[kind]} +)")
             if j == 0:
                 kept = " (kept)" if i < model.n_components else ""
                 ax.set_ylabel(f"eigen-motion {i + 1}{kept}\n{100 * share[i]:.1f}% of variance")
@@ -212,7 +251,11 @@ def plot_eigen_model(model_path, out: Path, n_show: int = 3) -> None:
                Line2D([], [], color="k", lw=1.0, ls=":", label="mean - 2 sd x eigen-motion")]
     fig.legend(handles=handles, loc="outside lower center", ncol=5, fontsize=9)
     labels = ", ".join(f"{v:g}" for v in sorted(set(np.round(model.labels, 4))))
-    fig.suptitle(f"{Path(str(model_path)).name}: the eigen-motions of {len(model.labels)} example cycles, step "
-                 f"lengths {labels} m", fontsize=10)
+    title = (f"{Path(str(model_path)).name}: the eigen-motions of {len(model.labels)} example cycles, step "
+             f"lengths {labels} m")
+    if still:
+        title += ("\nnot drawn, still in every example: "
+                  + ", ".join(f"{name} ({round(value, 6) + 0.0:g} deg)" for name, value in still))
+    fig.suptitle(title, fontsize=10)
     fig.savefig(out, dpi=100)
     plt.close(fig)

@@ -2,9 +2,10 @@
 step-length labels, or a required pose. Pure numpy/scipy; I/O only for the model ``.npz``."""
 
 from .examples import ExampleCycle, ExampleError, cycles_from_trajectory, detect_heel_strikes, walk_label
+from .legs import PlanarLegs, SpatialLegs
 from .model import EigenGaitModel, EigenModelError, FitOptions, fit_model, is_model_file
-from .synth import root_from_contact, synthesize_cycles, synthesize_walk
+from .synth import WalkEnds, root_from_contact, synthesize_cycles, synthesize_walk
 
 __all__ = ["ExampleCycle", "ExampleError", "cycles_from_trajectory", "detect_heel_strikes", "walk_label",
-           "EigenGaitModel", "EigenModelError", "FitOptions", "fit_model", "is_model_file", "root_from_contact",
-           "synthesize_cycles", "synthesize_walk"]
+           "EigenGaitModel", "EigenModelError", "FitOptions", "fit_model", "is_model_file", "PlanarLegs",
+           "root_from_contact", "SpatialLegs", "synthesize_cycles", "synthesize_walk", "WalkEnds"]

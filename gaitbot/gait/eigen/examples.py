@@ -3,9 +3,10 @@
 A cycle runs from a left heel strike to the next left heel strike (two steps, docs/gait-model.md
 section 1). Trajectory ``.npz`` files carry their heel strikes; CSV files (and recordings) do not,
 so heel strikes are detected from foot contact with forward kinematics (gait/footfall.py, the rule
-``gaitbot plot`` uses too): a leg's foot is in the air while its lowest sole point is more than
-``contact_tol_m`` above the other foot's; its heel strike is the first frame at which it comes
-back down to (nearly) the other foot's level.
+``gaitbot plot`` uses too; footfall3d.py for legs that roll): a leg's foot is in the air while its
+lowest sole point is more than ``contact_tol_m`` above the other foot's; its heel strike is the first
+frame at which it comes back down to (nearly) the other foot's level. A cycle holds the joints of the
+legs it is cut for (legs.py: the six pitch joints, or all twelve leg joints).
 
 Only the steady part of a walk gives examples: a generated walk starts from standing (its first
 step starts at rest) and ends with a closing step, so cycles that start at the first heel strike
@@ -24,6 +25,7 @@ from gaitbot.errors import UserError
 from ..footfall import CONTACT_TOL_FRACTION, detect_heel_strikes, foot_heights_in_body, heel_world_x
 from ..geometry import LegGeometry
 from ..trajectory import Trajectory
+from .legs import PlanarLegs
 
 __all__ = ["CONTACT_TOL_FRACTION", "ExampleCycle", "ExampleError", "cycles_from_trajectory", "detect_heel_strikes",
            "foot_heights_in_body", "heel_world_x", "walk_label"]
@@ -35,8 +37,9 @@ class ExampleError(UserError, ValueError):
 
 @dataclass(frozen=True)
 class ExampleCycle:
-    """One cycle: frames (n, 6) joint angles in radians at phases k/n, its duration, the phase of
-    the right heel strike inside it, and its label (step length, metres)."""
+    """One cycle: frames (n, J) joint angles in radians at phases k/n (the joints of the legs it was cut
+    for, legs.py), its duration, the phase of the right heel strike inside it, and its label (step length,
+    metres)."""
 
     angles_rad: np.ndarray
     duration_s: float
@@ -49,10 +52,13 @@ def _frame_of(trajectory: Trajectory, t_s: float) -> int:
     return int(np.argmin(np.abs(trajectory.t_s - t_s)))
 
 
-def cycles_from_trajectory(trajectory: Trajectory, geometry: LegGeometry, source: str = "",
+def cycles_from_trajectory(trajectory: Trajectory, legs, source: str = "",
                            keep_ends: bool = False) -> list[ExampleCycle]:
-    """The steady cycles of a walk (left heel strike to left heel strike), labelled by step length."""
-    strikes = list(trajectory.heel_strikes) or detect_heel_strikes(trajectory, geometry)
+    """The steady cycles of a walk (left heel strike to left heel strike), labelled by step length.
+    ``legs``: a legs.py object, or a LegGeometry for the planar legs (six pitch joints)."""
+    legs = PlanarLegs(legs) if isinstance(legs, LegGeometry) else legs
+    angles = trajectory.angles_of(legs.joints)
+    strikes = list(trajectory.heel_strikes) or legs.detect_heel_strikes(trajectory)
     if not keep_ends:
         strikes = strikes[1:-1]  # the first step starts from rest, the last one closes the feet
     lefts = [i for i, h in enumerate(strikes) if h.leg == "left"]
@@ -68,7 +74,7 @@ def cycles_from_trajectory(trajectory: Trajectory, geometry: LegGeometry, source
         duration = float(trajectory.t_s[k1] - trajectory.t_s[k0])
         phase = float((rights[0].t_s - inner[0].t_s) / duration)
         step = float(np.mean(np.diff([h.x_m for h in inner])))
-        cycles.append(ExampleCycle(trajectory.angles_rad[k0:k1].copy(), duration, phase, step, source))
+        cycles.append(ExampleCycle(angles[k0:k1].copy(), duration, phase, step, source))
     if not cycles:
         raise ExampleError(f"{source or 'trajectory'}: no complete steady cycle (left heel strike, right, left) "
                            f"found among {len(trajectory.heel_strikes) or 'the detected'} heel strikes")

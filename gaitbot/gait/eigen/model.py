@@ -21,6 +21,12 @@ of the examples' scores, warps, durations and right-strike phases on their step 
 required pose p at a time t' by ``alpha = alpha0 + pinv(Delta) (p - x(t'; alpha0))`` with
 ``Delta = [xi_1(t') ... xi_m(t')]`` (eq. 13, applied to the change from a base motion alpha0 so
 that the least-norm solution stays near the base walk rather than near the mean).
+
+Joints: a model learns the joints its examples hold, the robot's walker's joints (legs.py: the six
+pitch joints of a pitch-only robot, all twelve of a robot whose legs roll), and keeps their names; it
+learns no root channel: the root of a synthesised walk comes from foot contact (legs.py). File version
+2 stores the joint names, the root axes and (for 3D legs) the body geometry; a version 1 file is the six
+pitch joints with a planar root.
 """
 
 from __future__ import annotations
@@ -33,14 +39,24 @@ import numpy as np
 from gaitbot.errors import UserError
 from gaitbot.gait.npz_file import NpzProblem, numeric, read_npz
 
+from ..body import BodyGeometry
 from ..geometry import LegGeometry
+from ..joints import LEG_JOINTS, PITCH_JOINTS, is_leg_joint
 from .align import align_to_reference, resample_cycle, sample_phases
 from .basis import fit_coefficients, make_basis
 from .examples import ExampleCycle
+from .legs import PlanarLegs, SpatialLegs
 from .pose import leading_count, pose_pca
 
 MODEL_KIND = "gaitbot-eigen-gait"
-MODEL_VERSION = 1
+MODEL_VERSION = 2
+#: Versions this gaitbot reads: 1 (six pitch joints, no names stored) and 2 (joint names and root axes).
+READ_VERSIONS = (1, 2)
+#: Root axes a model's walks move in, each with the joints its legs have (legs.py).
+ROOT_AXES = {"xz": PITCH_JOINTS, "xyz": LEG_JOINTS}
+#: BodyGeometry's fields in the order the file's ``body_geometry`` holds them.
+BODY_GEOMETRY_FIELDS = ("thigh_m", "shank_m", "foot_m", "foot_width_m", "hip_width_m", "ankle_height_m",
+                        "heel_back_m", "sole_outward_m", "hip_below_root_m")
 
 
 #: The largest roughness penalty a fit takes (beyond it every motion is a straight line anyway).
@@ -101,9 +117,9 @@ class EigenGaitModel:
     samples: int
     periodic: bool
     roughness: float
-    pose_mean: np.ndarray  # (6,) rad
-    pose_axes: np.ndarray  # (6, d) U of eq. 1
-    pose_eigenvalues: np.ndarray  # (6,) all pose PCA eigenvalues (rad^2)
+    pose_mean: np.ndarray  # (J,) rad, one per joint of ``joints``
+    pose_axes: np.ndarray  # (J, d) U of eq. 1
+    pose_eigenvalues: np.ndarray  # (J,) all pose PCA eigenvalues (rad^2)
     coef_mean: np.ndarray  # (d, K) mean function's coefficients per reduced channel
     eigen_coefs: np.ndarray  # (M, d, K) every eigen-motion with a nonzero eigenvalue
     eigenvalues: np.ndarray  # (M,)
@@ -118,8 +134,28 @@ class EigenGaitModel:
     rate_hz: float
     sources: tuple = field(default_factory=tuple)
     pose_variance_dims: int = 0  # pose axes the variance rule alone would keep (0: not recorded)
-    pose_residuals_deg: np.ndarray | None = None  # (6,) largest joint error of the examples with 1..6 pose axes
+    pose_residuals_deg: np.ndarray | None = None  # (J,) largest joint error of the examples with 1..J pose axes
     robot: str = ""  # the robot the examples were walked for (its config's name); "" in files that predate it
+    joints: tuple = PITCH_JOINTS  # the joint of each pose column (canonical order, gaitbot.gait.joints)
+    root_axes: str = "xz"  # the root's axes a synthesised walk moves in, all from foot contact (legs.py)
+    body_geometry: BodyGeometry | None = None  # the 3D leg (root_axes "xyz"): the contact rule's geometry
+
+    def __post_init__(self) -> None:
+        if self.root_axes not in ROOT_AXES or tuple(self.joints) != ROOT_AXES[self.root_axes]:
+            raise ValueError(f"root axes {self.root_axes!r} go with the joints {ROOT_AXES.get(self.root_axes)}, "
+                             f"got {self.joints}")
+        if (self.root_axes == "xyz") != (self.body_geometry is not None):
+            raise ValueError("a model of 3D legs (root axes xyz) needs their body geometry, and only it")
+        if self.pose_mean.shape != (len(self.joints),):
+            raise ValueError(f"pose_mean has shape {self.pose_mean.shape}, expected ({len(self.joints)},)")
+
+    @property
+    def legs(self):
+        """The legs the model's walks stand on (legs.py); a planar robot whose root sits above its hips
+        gets its lift from its config (app/eigen.py)."""
+        if self.root_axes == "xyz":
+            return SpatialLegs(self.body_geometry)
+        return PlanarLegs(self.geometry)
 
     # -- basic evaluation -------------------------------------------------------------------
     @property
@@ -141,11 +177,11 @@ class EigenGaitModel:
         return self.basis.evaluate(s) @ coefs.T
 
     def poses(self, s, alpha) -> np.ndarray:
-        """Joint angles (n, 6) in radians at aligned phases s (eq. 12 then eq. 14)."""
+        """Joint angles (n, J) in radians at aligned phases s (eq. 12 then eq. 14), columns as ``joints``."""
         return self.pose_mean + self.reduced(s, alpha) @ self.pose_axes.T
 
     def eigen_motion(self, s, i: int) -> np.ndarray:
-        """xi_i(s) back in joint space without the mean: (n, 6) radians per unit coefficient."""
+        """xi_i(s) back in joint space without the mean: (n, J) radians per unit coefficient."""
         return (self.basis.evaluate(s) @ self.eigen_coefs[i].T) @ self.pose_axes.T
 
     # -- labels ------------------------------------------------------------------------------
@@ -184,9 +220,9 @@ class EigenGaitModel:
 
     # -- pose constraint (eq. 13) -------------------------------------------------------------
     def through_pose(self, pose_rad, s_prime: float, alpha0) -> tuple[np.ndarray, np.ndarray]:
-        """Coefficients whose motion passes through ``pose_rad`` (6,) at aligned phase s', nearest alpha0.
+        """Coefficients whose motion passes through ``pose_rad`` (J,) at aligned phase s', nearest alpha0.
 
-        Returns (alpha, miss_rad (6,)): the joint-space difference left (the part of the pose outside
+        Returns (alpha, miss_rad (J,)): the joint-space difference left (the part of the pose outside
         what the model's pose axes and eigen-motions can reach at s')."""
         alpha0 = np.asarray(alpha0, dtype=float)
         m = len(alpha0)
@@ -201,6 +237,8 @@ class EigenGaitModel:
     # -- file --------------------------------------------------------------------------------
     def save(self, path: str | Path) -> None:
         g = self.geometry
+        body = {} if self.body_geometry is None else {
+            "body_geometry": np.array([getattr(self.body_geometry, f) for f in BODY_GEOMETRY_FIELDS])}
         np.savez(Path(path), kind=np.array(MODEL_KIND), version=np.array(MODEL_VERSION),
                  basis_kind=np.array(self.basis_kind), n_basis=self.n_basis, samples=self.samples,
                  periodic=self.periodic, roughness=self.roughness, pose_mean=self.pose_mean,
@@ -211,7 +249,8 @@ class EigenGaitModel:
                  geometry=np.array([g.thigh, g.shank, g.foot, g.hip_width, g.ankle_height, g.heel_back]),
                  rate_hz=self.rate_hz, sources=np.array([str(s) for s in self.sources], dtype=str),
                  pose_variance_dims=self.pose_variance_dims, robot=np.array(self.robot),
-                 pose_residuals_deg=np.full(0, np.nan) if self.pose_residuals_deg is None else self.pose_residuals_deg)
+                 pose_residuals_deg=np.full(0, np.nan) if self.pose_residuals_deg is None else self.pose_residuals_deg,
+                 joints=np.array(self.joints, dtype=str), root_axes=np.array(self.root_axes), **body)
 
     @classmethod
     def load(cls, path: str | Path) -> "EigenGaitModel":
@@ -253,8 +292,10 @@ class EigenGaitModel:
             return value
 
         version = whole("version", 0, 10**6)
-        if version != MODEL_VERSION:
-            raise NpzProblem(f"model version {version}, this gaitbot reads {MODEL_VERSION}")
+        if version not in READ_VERSIONS:
+            raise NpzProblem(f"model version {version}, this gaitbot reads {', '.join(map(str, READ_VERSIONS))}")
+        joints, root_axes, body_geometry = _joints_and_legs(d, version)
+        n_joints = len(joints)
         limits = MODEL_LIMITS
         basis_kind = text("basis_kind")
         if basis_kind not in ("fourier", "bspline"):
@@ -268,8 +309,9 @@ class EigenGaitModel:
             raise NpzProblem(f"array 'roughness' must be 0..{MAX_ROUGHNESS:g}, got {roughness:g}")
         axes = numeric(d, "pose_axes", 2)
         dims = axes.shape[1]
-        if axes.shape[0] != 6 or not 1 <= dims <= 6:
-            raise NpzProblem(f"array 'pose_axes' has shape {axes.shape}, expected (6, d) with d 1..6")
+        if axes.shape[0] != n_joints or not 1 <= dims <= n_joints:
+            raise NpzProblem(f"array 'pose_axes' has shape {axes.shape}, expected ({n_joints}, d) with d "
+                             f"1..{n_joints} (one row per joint)")
         if not np.any(axes):
             raise NpzProblem("array 'pose_axes' is all zeros: no pose axis to synthesise along")
         eigen_coefs = numeric(d, "eigen_coefs", 3)
@@ -296,9 +338,9 @@ class EigenGaitModel:
         residuals = d.get("pose_residuals_deg")
         if residuals is not None:
             residuals = numeric(d, "pose_residuals_deg", 1, finite=False)
-            if residuals.shape not in ((0,), (6,)):
-                raise NpzProblem(f"array 'pose_residuals_deg' has shape {residuals.shape}, expected (6,)")
-        variance_dims = whole("pose_variance_dims", 0, 6) if "pose_variance_dims" in d else 0
+            if residuals.shape not in ((0,), (n_joints,)):
+                raise NpzProblem(f"array 'pose_residuals_deg' has shape {residuals.shape}, expected ({n_joints},)")
+        variance_dims = whole("pose_variance_dims", 0, n_joints) if "pose_variance_dims" in d else 0
         durations = shaped("durations_s", (n,))
         if not np.all((durations >= 0.2) & (durations <= 10.0)):
             raise NpzProblem("array 'durations_s' must hold cycle durations of 0.2..10 s")
@@ -309,12 +351,47 @@ class EigenGaitModel:
         if not np.all((phases > 0) & (phases < 1)):
             raise NpzProblem("array 'right_strike_phases' must hold phases between 0 and 1")
         return cls(basis_kind, n_basis, samples, bool(numeric(d, "periodic", 0)), roughness,
-                   shaped("pose_mean", (6,)), axes, shaped("pose_eigenvalues", (6,)),
+                   shaped("pose_mean", (n_joints,)), axes, shaped("pose_eigenvalues", (n_joints,)),
                    shaped("coef_mean", (dims, n_basis)), eigen_coefs, shaped("eigenvalues", (m,)),
                    whole("n_components", 1, m), scores, labels, shaped("warp_coefs", (n, n_basis)),
                    durations, phases, whole("label_degree", 0, 10),
                    LegGeometry(*map(float, geometry)), rate_hz, tuple(str(x) for x in sources),
-                   variance_dims, residuals, text("robot") if "robot" in d else "")
+                   variance_dims, residuals, text("robot") if "robot" in d else "", joints, root_axes, body_geometry)
+
+
+def _joints_and_legs(d: dict[str, np.ndarray], version: int) -> tuple[tuple, str, BodyGeometry | None]:
+    """The joint names, root axes and body geometry of a model file (version 1: the six pitch joints)."""
+    if version == 1:
+        return PITCH_JOINTS, "xz", None
+    for key in ("joints", "root_axes"):
+        if key not in d:
+            raise NpzProblem(f"missing array {key!r} (a version {version} model names its joints and root axes)")
+    raw = d["joints"]
+    if raw.dtype.kind != "U" or raw.ndim != 1 or not 1 <= len(raw) <= len(LEG_JOINTS):
+        raise NpzProblem(f"array 'joints' must be a list of 1 to {len(LEG_JOINTS)} joint names")
+    joints = tuple(str(name) for name in raw)
+    unknown = [name for name in joints if not is_leg_joint(name)]
+    if unknown:
+        raise NpzProblem(f"array 'joints' names {unknown[0][:40]!r}, not a leg joint gaitbot knows")
+    root = d["root_axes"]
+    if root.dtype.kind != "U" or root.ndim != 0 or str(root) not in ROOT_AXES:
+        raise NpzProblem(f"array 'root_axes' must be one of {', '.join(ROOT_AXES)}")
+    root_axes = str(root)
+    if joints != ROOT_AXES[root_axes]:
+        raise NpzProblem(f"array 'joints': a model whose root moves in {root_axes} learns "
+                         f"{', '.join(ROOT_AXES[root_axes])} (in that order), got {', '.join(joints)}")
+    if root_axes == "xz":
+        return joints, root_axes, None
+    body = numeric(d, "body_geometry", 1)
+    if body.shape != (len(BODY_GEOMETRY_FIELDS),):
+        raise NpzProblem(f"array 'body_geometry' has shape {body.shape}, expected ({len(BODY_GEOMETRY_FIELDS)},)")
+    values = dict(zip(BODY_GEOMETRY_FIELDS, map(float, body)))
+    positive = ("thigh_m", "shank_m", "foot_m", "foot_width_m", "hip_width_m")
+    if not (all(0 < values[f] <= 2.0 for f in positive) and all(abs(v) <= 2.0 for v in values.values())
+            and all(values[f] >= 0 for f in ("ankle_height_m", "heel_back_m", "hip_below_root_m"))):
+        raise NpzProblem("array 'body_geometry' must hold thigh, shank, foot, foot width, hip width (positive), "
+                         "ankle height, heel back, hip below root (0 or more) and sole outward, each within 2 m")
+    return joints, root_axes, BodyGeometry(**values)
 
 
 #: Sizes a model file may claim (a fitted model is far inside them): samples per cycle, basis functions,
@@ -336,14 +413,21 @@ def is_model_file(path: str | Path) -> bool:
 
 def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: float,
               options: FitOptions = FitOptions(), periodic: bool = True, robot: str = "",
-              on_progress=None) -> EigenGaitModel:
+              on_progress=None, legs=None) -> EigenGaitModel:
     """Seed 004 sections 3 and 4 on example cycles (see the module docstring). ``geometry`` is the leg that
     walked the examples and ``robot`` the robot they are for: the model keeps both, and synthesis for
-    another leg or robot is refused (app/eigen.py). ``on_progress(k, n)``, if given, is told as each of the n
-    example cycles is aligned (the time-consuming part: dynamic time warping)."""
+    another leg or robot is refused (app/eigen.py). ``legs`` (legs.py; default the planar legs of
+    ``geometry``) says which joints the cycles' columns are and how the root follows them. ``on_progress(k,
+    n)``, if given, is told as each of the n example cycles is aligned (the time-consuming part: dynamic time
+    warping)."""
+    legs = PlanarLegs(geometry) if legs is None else legs
     n = len(examples)
     if n < 2:
         raise EigenModelError(f"functional PCA needs at least 2 example cycles, got {n}")
+    widths = {e.angles_rad.shape[1] for e in examples}
+    if widths != {len(legs.joints)}:
+        raise EigenModelError(f"the example cycles hold {', '.join(map(str, sorted(widths)))} joints; "
+                              f"these legs have {len(legs.joints)} ({', '.join(legs.joints)})")
     if options.components is not None and not (1 <= options.components <= n - 1):
         raise EigenModelError(f"{options.components} eigen-motions requested, but {n} example cycles give at most "
                               f"{n - 1}; add examples or ask for fewer components")
@@ -365,7 +449,7 @@ def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: floa
         warps.append(h)
         if on_progress is not None:
             on_progress(k, n)
-    aligned = np.array(aligned)  # (N, S, 6)
+    aligned = np.array(aligned)  # (N, S, J)
 
     # pose PCA (eq. 1; pose.py)
     pose = pose_pca(aligned.reshape(-1, aligned.shape[-1]), options.pose_variance, options.pose_tolerance_deg)
@@ -404,4 +488,5 @@ def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: floa
                           np.array([e.duration_s for e in examples]),
                           np.array([e.right_strike_phase for e in examples]), options.label_degree, geometry,
                           float(rate_hz), tuple(sorted({e.source for e in examples})), pose.variance_dims,
-                          pose.residuals_deg, robot)
+                          pose.residuals_deg, robot, tuple(legs.joints), legs.root_axes,
+                          getattr(legs, "body_geometry", None))

@@ -15,24 +15,44 @@ Choices (stated once):
 - Transitions: the label (or the coefficients) is interpolated linearly from cycle to cycle, and
   within a cycle the coefficients go linearly from the cycle's start value to its end value, so
   the motion is continuous (seed 004 section 7, Figs. 8 and 9).
-- Root: the contact model of the walker (contact.py): the stance foot rolls without slip about its
-  lowest sole point, the root follows it in closed form; which foot supports is read from the
-  angles (gait/footfall.py ``root_from_contact``, also used by ``gaitbot record``).
+- Root: the contact model of the robot's walker, from the angles alone (legs.py): for the planar
+  walker the stance foot rolls without slip about its lowest sole point and the root follows it in
+  closed form (gait/footfall.py ``root_from_contact``, also used by ``gaitbot record``); for the
+  balanced walker of a robot whose legs roll, the stance sole stays flat and still under an upright
+  root, which gives the root's sideways sway and height too (gait/footfall3d.py).
+- Start and stop come from the robot's own walker (``WalkEnds``): the planar walker's two-step walks,
+  or the balanced walker's walks long enough that its preview control, which looks ahead to the stop,
+  has not yet seen it at the first left heel strike.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+
 import numpy as np
 
-from ..footfall import root_from_contact
+from ..footfall import root_from_contact  # noqa: F401  (the planar contact rule; legs.py uses it)
 from ..segments import CLEARANCE_WINDOW
-from ..geometry import LegGeometry, leg_points
-from ..trajectory import HeelStrike, Trajectory
+from ..geometry import LegGeometry
+from ..trajectory import Trajectory
 from .model import EigenGaitModel, EigenModelError
 
 
+@dataclass(frozen=True)
+class WalkEnds:
+    """How a synthesised walk starts and stops: ``walk(step_m, n_steps)``, the robot's own walker's walk of
+    ``n_steps`` steps of one length (a Trajectory of the model's joints, starting with the right foot), and
+    ``steps``, how many steps those walks have. The walk's head runs to its first left heel strike, its tail
+    from its last one."""
+
+    walk: Callable[[float, int], Trajectory]
+    steps: int = 2
+    join_order: int = 1  # continuity at the joins: 1 angle and velocity, 2 also acceleration (join_smoothly)
+
+
 def cycle_frames(model: EigenGaitModel, label_start: float, label_end: float, alpha_start, alpha_end, rate_hz: float):
-    """One cycle at the frame rate: (angles (n, 6), right-strike frame index)."""
+    """One cycle at the frame rate: (angles (n, J), right-strike frame index)."""
     duration, warp, right_phase = model.timing_for(0.5 * (label_start + label_end))
     n = max(8, int(round(duration * rate_hz)))
     phase = np.arange(n) / n
@@ -48,7 +68,7 @@ def synthesize_cycles(model: EigenGaitModel, cycle_labels, rate_hz: float | None
     """Angles of consecutive cycles. ``cycle_labels``: labels at the n+1 cycle boundaries.
 
     ``alphas`` (n+1, m) overrides the coefficients at the boundaries (direct or pose synthesis).
-    Returns (angles (N, 6), list of cycle start frames (n+1 with the end), list of right-strike frames).
+    Returns (angles (N, J), list of cycle start frames (n+1 with the end), list of right-strike frames).
     """
     rate = model.rate_hz if rate_hz is None else rate_hz
     labels = list(cycle_labels)
@@ -72,11 +92,39 @@ def _quintic_fade(x, p0, v0):
     return h0 * p0 + h1 * v0
 
 
-def join_smoothly(head: np.ndarray, body: np.ndarray, tail: np.ndarray, fade_frames: int) -> np.ndarray:
-    """head + body + tail, body corrected so angles and velocities are continuous at both joins.
+def _quintic_fade2(x, p0, v0, a0):
+    """Starts at p0 with slope v0 and curvature a0 (per unit x), reaches 0 with zero slope and curvature at x = 1."""
+    x = np.clip(np.asarray(x, float), 0.0, 1.0)[:, None]
+    h2 = 0.5 * x**2 - 1.5 * x**3 + 1.5 * x**4 - 0.5 * x**5  # value 0, slope 0, curvature 1 at 0; all 0 at 1
+    return _quintic_fade(x[:, 0], p0, v0) + h2 * a0
+
+
+def _continue(head: np.ndarray, body: np.ndarray, fade: int) -> np.ndarray:
+    """The correction (len(body), J) that makes ``body`` continue ``head`` in angle, velocity and acceleration:
+    at the body's first frame those of the parabola through the head's last three frames, one frame on."""
+    d1, d2 = head[-1] - head[-2], head[-2] - head[-3]
+    acc = d1 - d2
+    want_p, want_v, want_a = head[-1] + d1 + acc, d1 + 1.5 * acc, acc
+    got_v = (-3 * body[0] + 4 * body[1] - body[2]) / 2  # second-order one-sided differences
+    got_a = body[0] - 2 * body[1] + body[2]
+    x = np.arange(len(body)) / fade
+    return _quintic_fade2(x, want_p - body[0], (want_v - got_v) * fade, (want_a - got_a) * fade**2)
+
+
+def join_smoothly(head: np.ndarray, body: np.ndarray, tail: np.ndarray, fade_frames: int,
+                  order: int = 1) -> np.ndarray:
+    """head + body + tail, body corrected so angles and velocities (``order`` 1), and with ``order`` 2 also
+    accelerations, are continuous at both joins.
 
     ``head`` ends with the frame just before the body's first; ``tail`` starts with the frame after
-    the body's last. The correction fades over ``fade_frames`` at each end of the body."""
+    the body's last. The correction fades over ``fade_frames`` at each end of the body. Order 2 is for a
+    robot that balances: its root follows the stance leg's angles, and an acceleration that jumps at a join
+    (order 1 makes it 0 for a frame) moves the ZMP by the CoM height times that jump over g, centimetres for
+    the sway at a heel strike."""
+    if order == 2:
+        fade = max(3, min(fade_frames, len(body) // 2))
+        body = body + _continue(head, body, fade)
+        return np.vstack([head, body + _continue(tail[::-1], body[::-1], fade)[::-1], tail])
     body = body.copy()
     n = len(body)
     fade = max(2, min(fade_frames, n // 2))
@@ -95,13 +143,6 @@ def join_smoothly(head: np.ndarray, body: np.ndarray, tail: np.ndarray, fade_fra
     return np.vstack([head, body, tail])
 
 
-def heel_x(geometry: LegGeometry, angles_rad, root, frame: int, leg: str) -> float:
-    side = 0 if leg == "left" else 1
-    q = angles_rad[frame, 3 * side:3 * side + 3]
-    _, _, heel, _ = leg_points(geometry, q[0], q[1], q[2])
-    return float(heel[0] + root[frame, 0])
-
-
 def check_labels(model: EigenGaitModel, labels, extrapolate: float = 0.0) -> None:
     lo, hi = model.label_range()
     span = hi - lo
@@ -112,13 +153,14 @@ def check_labels(model: EigenGaitModel, labels, extrapolate: float = 0.0) -> Non
 
 
 def assemble_walk(model: EigenGaitModel, head: Trajectory, body: np.ndarray, body_rights, body_cycle_starts,
-                  tail: Trajectory, blend_frames: int) -> Trajectory:
-    """Head (walker, ends just before a left heel strike) + body cycles + tail (walker, from a left heel strike)."""
-    g = model.geometry
-    angles = join_smoothly(head.angles_rad, body, tail.angles_rad, blend_frames)
+                  tail: Trajectory, blend_frames: int, legs=None, join_order: int = 1) -> Trajectory:
+    """Head (walker, ends just before a left heel strike) + body cycles + tail (walker, from a left heel strike);
+    the root from contact of the legs (legs.py; default the model's), starting where the head starts."""
+    legs = model.legs if legs is None else legs
+    angles = join_smoothly(head.angles_rad, body, tail.angles_rad, blend_frames, join_order)
     rate = model.rate_hz
     t = np.arange(len(angles)) / rate
-    root, _ = root_from_contact(g, angles, head.root_m[0])
+    root = legs.root_from_contact(angles, head.root_m[0])
     offset = len(head)
     events = [(int(round((h.t_s - head.t_s[0]) * rate)), h.leg) for h in head.heel_strikes
               if h.t_s < head.t_s[-1] + 0.5 / rate]
@@ -128,8 +170,8 @@ def assemble_walk(model: EigenGaitModel, head: Trajectory, body: np.ndarray, bod
     events += [(tail_offset + int(round((h.t_s - tail.t_s[0]) * rate)), h.leg) for h in tail.heel_strikes]
     for frame, leg in sorted(events):
         frame = min(frame, len(t) - 1)
-        strikes.append(HeelStrike(float(t[frame]), leg, heel_x(g, angles, root, frame, leg)))
-    return Trajectory.sagittal(t, angles, root, strikes)
+        strikes.append(legs.heel_strike(angles, root, float(t[frame]), frame, leg))
+    return Trajectory(t, angles, root, tuple(strikes), tuple(model.joints))
 
 
 def _walker_part(geometry, settings, step_m: float, n_steps: int):
@@ -144,13 +186,16 @@ def _frame(trajectory: Trajectory, t_s: float) -> int:
 
 def synthesize_walk(model: EigenGaitModel, settings, step_start_m: float, step_end_m: float | None = None,
                     cycles: int = 3, components: int | None = None, alphas=None,
-                    blend_cycles: float = 0.5 * CLEARANCE_WINDOW[0]) -> Trajectory:
-    """A whole walk: the walker's start (two steps at ``step_start_m``), ``cycles`` synthesised cycles
+                    blend_cycles: float = 0.5 * CLEARANCE_WINDOW[0], ends: WalkEnds | None = None,
+                    legs=None) -> Trajectory:
+    """A whole walk: the walker's start (its first steps at ``step_start_m``), ``cycles`` synthesised cycles
     (labels going linearly from ``step_start_m`` to ``step_end_m``), the walker's closing step and stand.
 
     ``alphas`` (cycles + 1, m): coefficients at the cycle boundaries instead of the label regression
     (the labels then only choose the timing and the walker's start and stop).
     ``settings``: the walker's WalkSettings; its rate must be the model's.
+    ``ends``: the robot's walker for the start and stop (default: the planar walker of the model's leg);
+    ``legs``: the contact rule of the root (legs.py; default the model's).
     """
     if cycles < 1:
         raise EigenModelError(f"--cycles must be 1 or more, got {cycles}")
@@ -158,21 +203,34 @@ def synthesize_walk(model: EigenGaitModel, settings, step_start_m: float, step_e
     check_labels(model, [step_start_m, end])
     if abs(settings.rate_hz - model.rate_hz) > 1e-6 * model.rate_hz:
         raise EigenModelError(f"the robot's frame rate {settings.rate_hz:g} Hz is not the model's {model.rate_hz:g} Hz")
+    if ends is None:
+        ends = WalkEnds(lambda step_m, n: _walker_part(model.geometry, settings, step_m, n))
     labels = list(np.linspace(step_start_m, end, cycles + 1))
     body, starts, rights = synthesize_cycles(model, labels, components=components, alphas=alphas)
-    first = _walker_part(model.geometry, settings, step_start_m, 2)
+    first = _ends_walk(model, ends, step_start_m)
     k_head = _frame(first, [h for h in first.heel_strikes if h.leg == "left"][0].t_s)
     head = Trajectory(first.t_s[:k_head], first.angles_rad[:k_head], first.root_m[:k_head],
-                      tuple(h for h in first.heel_strikes if h.t_s < first.t_s[k_head] - 0.5 / model.rate_hz))
-    last = _walker_part(model.geometry, settings, end, 2)
+                      tuple(h for h in first.heel_strikes if h.t_s < first.t_s[k_head] - 0.5 / model.rate_hz),
+                      first.joints)
+    last = first if end == step_start_m else _ends_walk(model, ends, end)
     lefts = [h for h in last.heel_strikes if h.leg == "left"]
     k_tail = _frame(last, lefts[-1].t_s)
     tail = Trajectory(last.t_s[k_tail + 1:], last.angles_rad[k_tail + 1:], last.root_m[k_tail + 1:],
-                      tuple(h for h in last.heel_strikes if h.t_s > last.t_s[k_tail] + 0.5 / model.rate_hz))
+                      tuple(h for h in last.heel_strikes if h.t_s > last.t_s[k_tail] + 0.5 / model.rate_hz),
+                      last.joints)
     # the body's last cycle ends just before a left heel strike; the tail's first frame is just after
     # it, so the strike frame itself is the model's (its phase 1 = phase 0 of the next cycle)
     strike_pose = model.poses([0.0], alphas[-1] if alphas is not None else model.coefficients_for(end, components))
     body = np.vstack([body, strike_pose])
     starts = list(starts)
     fade = int(round(blend_cycles * len(body) / cycles))
-    return assemble_walk(model, head, body, rights, starts, tail, fade)
+    return assemble_walk(model, head, body, rights, starts, tail, fade, legs, ends.join_order)
+
+
+def _ends_walk(model: EigenGaitModel, ends: WalkEnds, step_m: float) -> Trajectory:
+    """The walker's walk for a start or a stop, which must move the model's joints."""
+    walk = ends.walk(step_m, ends.steps)
+    if tuple(walk.joints) != tuple(model.joints):
+        raise EigenModelError(f"the robot's walker moves {', '.join(walk.joints)}, the model learnt "
+                              f"{', '.join(model.joints)}: fit the model on this robot's walks")
+    return walk
