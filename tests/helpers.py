@@ -200,12 +200,15 @@ def heights_under(pieces, x):
     return out
 
 
-def fk_foot(cfg, q, root):
-    """Ankle, heel and toe in the world of one leg from hip, knee, ankle flexion (the tests' own kinematics,
-    docs/gait-model.md section 1; the heel is heel_back_m behind the ankle's projection on the sole)."""
+def fk_foot(cfg, q, root_xz):
+    """Ankle, heel and toe in the sagittal plane (x forward, z up) of one leg from hip, knee, ankle flexion
+    (the tests' own kinematics, docs/gait-model.md section 1; the heel is heel_back_m behind the ankle's
+    projection on the sole). ``root_xz`` is the root's (x, z): a trajectory's ``root_xz_m``, not its 3D ``root_m``."""
     g = cfg.geometry
+    root_xz = np.asarray(root_xz)
+    assert root_xz.shape == (len(q), 2), f"fk_foot takes the root's (x, z), got shape {root_xz.shape}"
     h, k, a = q[:, 0], q[:, 1], q[:, 2]
-    ankle = root + np.column_stack([g.thigh_m * np.sin(h) + g.shank_m * np.sin(h - k),
+    ankle = root_xz + np.column_stack([g.thigh_m * np.sin(h) + g.shank_m * np.sin(h - k),
                                     -g.thigh_m * np.cos(h) - g.shank_m * np.cos(h - k)])
     p = h - k + a  # sole pitch, toe up
     along_sole = np.column_stack([np.cos(p), np.sin(p)])
@@ -221,7 +224,7 @@ def swing_clearances(cfg, trajectory, treads=()) -> list[tuple[float, float, flo
     pieces = surface_pieces(treads)
     out = []
     for side in (0, 1):
-        ankle, heel, toe = fk_foot(cfg, trajectory.angles_rad[:, 3 * side:3 * side + 3], trajectory.root_m)
+        ankle, heel, toe = fk_foot(cfg, trajectory.angles_rad[:, 3 * side:3 * side + 3], trajectory.root_xz_m)
         u = np.linspace(0.0, 1.0, 21)
         sole = heel[:, None, :] + u[None, :, None] * (toe - heel)[:, None, :]
         gap = (sole[..., 1] - heights_under(pieces, sole[..., 0])).min(axis=1)

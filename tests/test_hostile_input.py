@@ -294,9 +294,17 @@ WALK_OPTIONS = ["--rate", "--distance", "--max-step", "--perturb", "--clearance"
 @given(option=st.sampled_from(WALK_OPTIONS), value=st.sampled_from(HOSTILE_NUMBERS),
        command=st.sampled_from(["plan", "generate", "walk"]))
 def test_walk_options_with_hostile_numbers(option, value, command, tmp_path_factory):
+    """A walk checks its plan against the robot's servos first: a valid but extreme leg (``--foot=1e-9``: no toe
+    to roll over, so the knee flexes at lift-off faster than the XL430's 12000 deg/s^2) is refused before
+    anything moves, exit 1 (the check found a fault, docs/command-line.md), in one line; plan and generate
+    check no servo: 0 or 2."""
     extra = {"generate": ["-o", tmp_path_factory.mktemp("out") / "w.csv"], "walk": ["--dry-run"], "plan": []}[command]
     distance = [] if option == "--distance" else ["--distance", "0.1"]
-    assert_cli_behaves(cli(command, *distance, f"{option}={value}", *extra))
+    result = cli(command, *distance, f"{option}={value}", *extra)
+    assert_cli_behaves(result, allowed=(0, 1, 2) if command == "walk" else (0, 2))
+    if result["value"] == 1:
+        lines = [line for line in result["stderr"].splitlines() if line.strip()]
+        assert len(lines) == 1 and "walk refused before anything moved" in lines[0], result["stderr"]
 
 
 @FUZZ

@@ -1,4 +1,4 @@
-"""Swing clearance of every swing of the shipped walks: flat walks and every example terrain course, every robot.
+"""Swing clearance of every swing of the planar walks: flat and every example terrain course, every pitch-only robot.
 
     python tools/swing_clearance.py              # the table
     python tools/swing_clearance.py --markdown   # the docs' figure (docs/gait.md, docs/terrain.md)
@@ -47,8 +47,10 @@ def walks(name: str):
 
 
 def measure():
+    """The rows of the table, for every shipped robot the planar walker drives (a robot whose legs roll walks
+    balanced, its swings checked by tests/gait/test_balance_exact.py)."""
     rows = []
-    names = shipped_config_names()
+    names = [name for name in shipped_config_names() if not load_robot_config(resolve_config(name)).is_3d]
     with progress("swing clearance", total=len(names) * (1 + len(COURSES)), unit="walk") as bar:
         for name in names:
             config = load_robot_config(resolve_config(name))

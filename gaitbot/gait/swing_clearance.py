@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .geometry import LegGeometry, leg_points
+from .joints import PITCH_JOINTS
 from .trajectory import Trajectory
 
 SOLE_POINTS = 9
@@ -42,10 +43,14 @@ class Swing:
 
 
 def sole_heights(geometry: LegGeometry, trajectory: Trajectory, side: int, terrain=None) -> tuple[np.ndarray, np.ndarray]:
-    """(lowest sole point's height above the ground under it, ankle x), per frame, of one foot (0 left, 1 right)."""
+    """(lowest sole point's height above the ground under it, ankle x), per frame, of one foot (0 left, 1 right).
+    A planar walk's: the six pitch joints, the legs in the sagittal plane (x forward, z up)."""
+    if tuple(trajectory.joints) != PITCH_JOINTS:
+        raise ValueError(f"swing clearance is measured on planar walks (the six pitch joints), not {trajectory.joints}")
     q = trajectory.angles_rad[:, 3 * side:3 * side + 3]
     _, ankle, heel, toe = leg_points(geometry, q[:, 0], q[:, 1], q[:, 2])
-    heel, toe, ankle = heel + trajectory.root_m, toe + trajectory.root_m, ankle + trajectory.root_m
+    root = trajectory.root_xz_m  # the sagittal plane the leg points are in: (x forward, z up)
+    heel, toe, ankle = heel + root, toe + root, ankle + root
     u = np.linspace(0.0, 1.0, SOLE_POINTS)
     points = heel[:, None, :] + u[None, :, None] * (toe - heel)[:, None, :]
     ground = terrain.height_at(points[..., 0]) if terrain is not None else 0.0

@@ -1,10 +1,11 @@
-"""The balanced op3 walk checked from its trajectory file alone, with forward kinematics written here.
+"""The balanced walk of every shipped robot whose legs roll (op3, bioloid) checked from its trajectory file
+alone, with forward kinematics written here.
 
 The FK below is built from the joint conventions as the issue states them (pitch joints flexion
 positive, hip_roll abduction positive, ankle_roll in its hip_roll's sense, hip_yaw toe outward), with
 rotations about each joint's axis composed down the chain (Rodrigues), and the leg's numbers read from
-config/op3.toml with tomllib: it imports nothing of gaitbot's kinematics. From the angles and root of
-``gaitbot generate --robot op3`` it finds the soles flat and still in stance, the heels where
+the robot's config/<robot>.toml with tomllib: it imports nothing of gaitbot's kinematics. From the angles
+and root of ``gaitbot generate --robot NAME`` it finds the soles flat and still in stance, the heels where
 ``gaitbot plan --json`` says, the swing soles the configured clearance up, every joint inside its limits.
 """
 
@@ -18,13 +19,18 @@ import numpy as np
 import pytest
 
 from gaitbot.gait.trajectory import Trajectory
+from gaitbot.robot.config import load_robot_config
 from helpers import CONFIG_DIR
 
-OP3 = tomllib.loads((CONFIG_DIR / "op3.toml").read_text())
-GEO = OP3["geometry"]
-LEG_M = GEO["thigh_m"] + GEO["shank_m"]
+# The robots the balanced walker drives: those whose legs roll (pitch-only ones walk planar: test_gait_walk.py).
+BALANCED = sorted(p.stem for p in CONFIG_DIR.glob("*.toml") if load_robot_config(p).is_3d)
 KINDS = ("hip_yaw", "hip_roll", "hip_pitch", "knee_pitch", "ankle_pitch", "ankle_roll")
-STEPS = "0.03,0.05,0.04,0.05,0.02,0.05,0.035"
+STEP_SHARES = (0.6, 1.0, 0.8, 1.0, 0.4, 1.0, 0.7)  # uneven steps, as shares of the robot's max_step_m
+
+
+def steps_m(robot: dict) -> list[float]:
+    """The walk's step lengths: op3 (max 0.05 m) walks 0.03, 0.05, 0.04, 0.05, 0.02, 0.05, 0.035."""
+    return [round(share * robot["gait"]["max_step_m"], 4) for share in STEP_SHARES]
 
 
 def axis(kind: str, s: float) -> np.ndarray:
@@ -41,30 +47,36 @@ def rodrigues(a, angle: float) -> np.ndarray:
     return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * k @ k
 
 
-def sole(q6, root, side: str):
-    """(rotation of the foot, its four sole corners (4, 3), its sole centre (3,), heel point (3,)) in the world."""
+def sole(geo: dict, q6, root, side: str):
+    """(rotation of the foot, its four sole corners (4, 3), its sole centre (3,), heel point (3,)) in the world,
+    for the [geometry] table ``geo`` of a robot's TOML."""
+    g = {"sole_outward_m": 0.0, **geo}  # sole_outward_m is optional (0: the sole centred under the ankle)
     s = 1.0 if side == "left" else -1.0
     r = np.eye(3)
-    hip = np.asarray(root) + [0.0, s * GEO["hip_width_m"] / 2, -GEO["hip_below_root_m"]]
+    hip = np.asarray(root) + [0.0, s * g["hip_width_m"] / 2, -g["hip_below_root_m"]]
     frames = []
     for kind, angle in zip(KINDS, q6):
         r = r @ rodrigues(axis(kind, s), angle)
         frames.append(r)
-    knee = hip + frames[2] @ [0.0, 0.0, -GEO["thigh_m"]]
-    ankle = knee + frames[3] @ [0.0, 0.0, -GEO["shank_m"]]
+    knee = hip + frames[2] @ [0.0, 0.0, -g["thigh_m"]]
+    ankle = knee + frames[3] @ [0.0, 0.0, -g["shank_m"]]
     foot = frames[5]
-    ahead, back = GEO["foot_m"] - GEO["heel_back_m"], -GEO["heel_back_m"]
-    out, width = s * GEO["sole_outward_m"], GEO["foot_width_m"] / 2
-    corners = np.array([ankle + foot @ [x, out + w, -GEO["ankle_height_m"]] for x in (back, ahead) for w in (-width, width)])
-    centre = ankle + foot @ [(ahead + back) / 2, out, -GEO["ankle_height_m"]]
-    heel = ankle + foot @ [back, out, -GEO["ankle_height_m"]]
+    ahead, back = g["foot_m"] - g["heel_back_m"], -g["heel_back_m"]
+    out, width = s * g["sole_outward_m"], g["foot_width_m"] / 2
+    corners = np.array([ankle + foot @ [x, out + w, -g["ankle_height_m"]] for x in (back, ahead) for w in (-width, width)])
+    centre = ankle + foot @ [(ahead + back) / 2, out, -g["ankle_height_m"]]
+    heel = ankle + foot @ [back, out, -g["ankle_height_m"]]
     return foot, corners, centre, heel
 
 
-@pytest.fixture(scope="module")
-def walk(tmp_path_factory):
-    """The trajectory file and plan of an uneven-stepped op3 walk, and every frame's soles by our FK."""
-    path = tmp_path_factory.mktemp("op3") / "walk.csv"
+@pytest.fixture(scope="module", params=BALANCED)
+def walk(request, tmp_path_factory):
+    """The robot's TOML, the trajectory file and plan of an uneven-stepped walk of it, and every frame's soles
+    by our FK."""
+    name = request.param
+    robot = tomllib.loads((CONFIG_DIR / f"{name}.toml").read_text())
+    steps = ",".join(f"{length:g}" for length in steps_m(robot))
+    path = tmp_path_factory.mktemp(name) / "walk.csv"
     import contextlib
     import io
 
@@ -72,20 +84,24 @@ def walk(tmp_path_factory):
 
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):
-        assert main(["generate", "--robot", "op3", "--steps", STEPS, "-o", str(path)]) == 0
+        assert main(["generate", "--robot", name, "--steps", steps, "-o", str(path)]) == 0
         buffer.truncate(0)
         buffer.seek(0)
-        assert main(["plan", "--robot", "op3", "--steps", STEPS, "--json"]) == 0
+        assert main(["plan", "--robot", name, "--steps", steps, "--json"]) == 0
     plan = json.loads(buffer.getvalue())
     trajectory = Trajectory.load(path)
     names = [f"{k}_{side}" for side in ("left", "right") for k in KINDS]
     q = trajectory.angles_of(names)
     feet = {}
     for i, side in enumerate(("left", "right")):
-        rows = [sole(q[k, 6 * i:6 * i + 6], trajectory.root_m[k], side) for k in range(len(q))]
+        rows = [sole(robot["geometry"], q[k, 6 * i:6 * i + 6], trajectory.root_m[k], side) for k in range(len(q))]
         feet[side] = {"rot": np.array([r[0] for r in rows]), "corners": np.array([r[1] for r in rows]),
                       "centre": np.array([r[2] for r in rows]), "heel": np.array([r[3] for r in rows])}
-    return trajectory, plan, feet
+    return robot, trajectory, plan, feet
+
+
+def leg_m(robot: dict) -> float:
+    return robot["geometry"]["thigh_m"] + robot["geometry"]["shank_m"]
 
 
 def stance(foot) -> np.ndarray:
@@ -99,7 +115,7 @@ def spells(mask: np.ndarray) -> list[np.ndarray]:
 
 
 def test_stance_soles_are_flat_and_still(walk):
-    _, _, feet = walk
+    robot, _, _, feet = walk
     for side, foot in feet.items():
         down = stance(foot)
         assert down.sum() > 100
@@ -107,27 +123,28 @@ def test_stance_soles_are_flat_and_still(walk):
         assert np.abs(foot["rot"][down] - np.eye(3)).max() < 1e-8, f"{side} sole not flat in stance"
         for spell in spells(down):
             slide = np.abs(foot["centre"][spell, :2] - foot["centre"][spell[0], :2]).max()
-            assert slide < 1e-6 * LEG_M, f"{side} sole slides {slide:.3g} m"
+            assert slide < 1e-6 * leg_m(robot), f"{side} sole slides {slide:.3g} m"
         assert (foot["corners"][:, :, 2] > -1e-9).all(), f"{side} sole goes under the floor"
 
 
 def test_heels_land_on_their_planned_footholds(walk):
-    trajectory, plan, feet = walk
-    lengths = [float(v) for v in STEPS.split(",")]
+    robot, trajectory, plan, feet = walk
+    lengths = steps_m(robot)
     planned = plan["heel_strikes"]
     assert [h["x_m"] for h in planned[:len(lengths)]] == pytest.approx(np.cumsum(lengths), abs=1e-12)
     for strike in planned:
         k = int(round(strike["t_s"] * 60))
         heel = feet[strike["leg"]]["heel"][k]
         assert stance(feet[strike["leg"]])[k] and not stance(feet[strike["leg"]])[k - 1]  # it lands on this frame
-        assert abs(heel[0] - strike["x_m"]) < 1e-6 * LEG_M
+        assert abs(heel[0] - strike["x_m"]) < 1e-6 * leg_m(robot)
         centre = feet[strike["leg"]]["centre"][k]
-        assert abs(centre[1] - strike["y_m"]) < 1e-6 * LEG_M
+        assert abs(centre[1] - strike["y_m"]) < 1e-6 * leg_m(robot)
 
 
 def test_swing_soles_keep_the_configured_clearance(walk):
-    _, _, feet = walk
-    clearance = OP3["gait"]["clearance_m"]
+    """docs/balance.md: the whole flat sole clearance_m up from 20% to 80% of each swing's time."""
+    robot, _, _, feet = walk
+    clearance = robot["gait"]["clearance_m"]
     swings = 0
     for foot in feet.values():
         for spell in spells(~stance(foot)):
@@ -137,16 +154,16 @@ def test_swing_soles_keep_the_configured_clearance(walk):
             assert lowest >= clearance - 1e-9
             assert lowest < clearance + 0.004  # and not much more than asked
             swings += 1
-    assert swings == len(STEPS.split(",")) + 1  # each step, and the closing step
+    assert swings == len(STEP_SHARES) + 1  # each step, and the closing step
 
 
 def test_every_joint_stays_inside_its_limits(walk):
-    trajectory, _, _ = walk
-    for name, joint in OP3["joints"].items():
+    robot, trajectory, _, _ = walk
+    for name, joint in robot["joints"].items():
         angles = trajectory.joint_deg(name)
         assert joint["min_deg"] <= angles.min() and angles.max() <= joint["max_deg"], name
 
 
 def test_the_walk_starts_and_ends_with_every_joint_at_zero(walk):
-    trajectory, _, _ = walk
+    _, trajectory, _, _ = walk
     assert np.abs(trajectory.angles_rad[[0, -1]]).max() == 0.0

@@ -52,7 +52,7 @@ def test_the_clearance_trace_is_continuous_over_the_kerb_edge(kerb):
     profile = ground_profile(terrain, -0.5, 2.0)
     jumps = []
     for side in (0, 1):
-        _, heel, toe = fk_foot(cfg, trajectory.angles_rad[:, 3 * side:3 * side + 3], trajectory.root_m)
+        _, heel, toe = fk_foot(cfg, trajectory.angles_rad[:, 3 * side:3 * side + 3], trajectory.root_xz_m)
         assert np.abs(np.diff(sole_clearance(heel, toe, profile))).max() < 0.005
         naive = np.minimum(heel[:, 1] - terrain.height_at(heel[:, 0]), toe[:, 1] - terrain.height_at(toe[:, 0]))
         jumps.append(np.abs(np.diff(naive)).max())
