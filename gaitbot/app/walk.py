@@ -61,9 +61,6 @@ def _warn_line(text: str) -> None:
 def run(args) -> int:
     check_sim_arguments(args)
     refuse_port_in_dry_run(args)
-    if getattr(args, "demo", False):
-        print(f"note: no --steps, --distance, --terrain or --trajectory: walking the demo, --distance "
-              f"{args.distance:g}", file=sys.stderr)
     check_reply_timeout(args.reply_timeout_ms)
     config = load_robot(args.robot, getattr(args, "calibration", None))
     check_rate_option(config, args.rate)
@@ -108,6 +105,9 @@ def run(args) -> int:
         if isinstance(exc, RecordingFailed) and isinstance(exc.__cause__, OSError):
             reason = exc.__cause__.strerror or exc.__cause__
         raise UsageError(f"--record {args.record}: cannot write the recording ({reason}); nothing was sent") from None
+    if getattr(args, "demo", False):  # said once every input was found good: a refusal stays one line (exit 2)
+        print(f"note: no --steps, --distance, --terrain or --trajectory: walking the demo, --distance "
+              f"{args.distance:g}", file=sys.stderr)
     velocity, acceleration = joint_limits_ticks(config)
     for note in gain_notes(config):
         print(f"note: {note}", file=sys.stderr)

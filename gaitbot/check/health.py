@@ -89,7 +89,11 @@ def health_report(packets, framing: str, models: dict[int, ServoModel], threshol
         if p.direction == "tx":
             block = blocks.get(pk.packet_id)
             if pk.instruction == wire.INST_READ and block is not None:
-                asked[pk.packet_id] = (pk.address, pk.data_length) == (block.address, block.length)
+                # the block itself, or the block and a few bytes more: a walk's read-back asks a servo whose
+                # last read went unanswered for a longer one, so that a late reply cannot pass for its answer
+                # (docs/bus-faults.md, "Matched"); the block leads either way
+                asked[pk.packet_id] = (pk.address == block.address and pk.data_length is not None
+                                       and pk.data_length >= block.length)
             continue
         servo_id = pk.packet_id
         if not asked.pop(servo_id, False):

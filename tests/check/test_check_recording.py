@@ -367,3 +367,51 @@ def test_goal_layouts_used_by_the_tests_match_the_models():
     assert goal_layout("xl430-biped") == (116, 4)
     assert goal_layout("ax12a-biped") == (30, 2)
     assert goal_layout("sts3215-biped") == (42, 2)
+
+
+
+# ----------------------------------------------------------------------------------------- servo health reads
+
+
+def test_check_reads_every_health_read_back_also_the_longer_ones_after_a_miss(tmp_path):
+    """A walk's read-back reads a servo's health block; after a miss the servo is asked for the block and a byte
+    more (the read-back's length rule, docs/bus-faults.md), and that answer is a health reading as well: check
+    decodes exactly the readings the walk's monitor saw, the longer ones included."""
+    from gaitbot.bus.factory import make_bus
+    from gaitbot.bus.log import BusRecorder
+    from gaitbot.robot.calibration import standing_ticks
+    from gaitbot.robot.walk_settings import joint_limits_ticks
+    from gaitbot.servos import wire
+    from gaitbot.servos.health import health_block
+    from gaitbot.stream.clock import VirtualClock
+    from gaitbot.stream.health import HealthMonitor
+    from gaitbot.stream.session import walk_session
+
+    robot = config("xl430-biped")
+    clock = VirtualClock()
+    path = tmp_path / "run.jsonl"
+    recorder = BusRecorder(path, robot=robot.name, joints={j.name: j.id for j in robot.joints}, clock=clock.now,
+                           rate_hz=robot.gait.rate_hz)
+    bus = make_bus(robot.bus.backend, robot.bus.protocol, "mock", robot.bus.baudrate, robot.models_by_id,
+                   dry_run=True, recorder=recorder)
+    mock = bus.port._inner  # the MockPort under the recording port
+    monitor = HealthMonitor.for_robot(robot, clock=clock.now)
+
+    def on_frame(k, _stats):
+        if k in (20, 50):  # the next read-back's status packet is lost: that servo is asked again, longer
+            mock.drop_next_replies(1)
+
+    frames = np.tile(standing_ticks(robot), (90, 1))
+    velocity, acceleration = joint_limits_ticks(robot)
+    result = walk_session(bus, robot.ids, frames, standing_ticks(robot), max_velocity_ticks_per_s=velocity,
+                          max_accel_ticks_per_s2=acceleration, period_s=1 / robot.gait.rate_hz, clock=clock,
+                          on_frame=on_frame, handle_sigterm=False, health=monitor)
+    recorder.close()
+    assert result.outcome == "completed", result.message()
+    block = health_block(robot.joints[0].model)
+    reads = [wire.parse(p, mock.framing, status=False) for p in mock.tx_packets]
+    lengths = [wire.address_length_and_rest(f.params, mock.framing)[1] for f in reads if f.instruction == wire.INST_READ]
+    # the re-reads, and the reads of those servos for as long as the lost reply might still come, a byte longer
+    assert lengths.count(block.length + 1) >= 2 and set(lengths) == {block.length, block.length + 1}
+    report = check_recording(robot, path)
+    assert report.health is not None and report.health.n_readings == monitor.readings

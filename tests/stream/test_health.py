@@ -86,20 +86,24 @@ def walk(robot, bus, monitor):
 
 
 def test_a_servo_heating_mid_walk_stops_it_with_the_bus_fault_ramp(monkeypatch):
+    """The knee heats up after 40 of the walk's per-frame reads. Since the merge with the faults work those
+    reads are the budgeted read-backs (``Bus.read_back`` of the health block, ``set_read_back_blocks``), not
+    ``read_health`` (now only the once-per-servo check before torque on), so the reads counted are those."""
     robot = config("xl430-biped")
     bus, table = hot_bus(robot, 2, temperature_c=40)
     monitor = HealthMonitor.for_robot(robot)
     reads = {"n": 0}
-    original = bus.read_health
+    original = bus.read_back
 
-    def heating(servo_id):
+    def heating(servo_id, budget_s):
         reads["n"] += 1
         if reads["n"] == 40:
             table[146] = 67  # the knee reaches its stop temperature
-        return original(servo_id)
+        return original(servo_id, budget_s)
 
-    monkeypatch.setattr(bus, "read_health", heating)
+    monkeypatch.setattr(bus, "read_back", heating)
     result = walk(robot, bus, monitor)
+    assert reads["n"] > 40  # it heated mid-walk, read back in the walk's own frames
     assert (result.outcome, result.exit_code) == ("health_stop", 1)
     assert "servo 2 (knee_pitch_left) is at 67 °C" in result.message() and "ramped to the stand pose" in result.message()
     assert result.reached_stand

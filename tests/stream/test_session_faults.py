@@ -57,8 +57,8 @@ def faulty_walk(tmp_path, robot: str, fault: str, victim: int, monkeypatch, reco
                            rate_hz=config.gait.rate_hz)
     chains: list[FaultyChain] = []
 
-    def chain(backend, protocol, models, port_name="mock"):
-        port = FaultyChain(backend, protocol, models, port_name)
+    def chain(backend, protocol, models, port_name="mock", baudrate=None):
+        port = FaultyChain(backend, protocol, models, port_name, baudrate=baudrate)
         port.silent, port.damaged = set(), set()
         chains.append(port)
         return port
