@@ -183,7 +183,9 @@ def test_step_lengths_are_exact_heel_to_heel(walk):
 def test_sag_feedforward_is_gravity_torque_over_stiffness(walk):
     """Goal - plan = the pose's gravity torque / kp; largest at the stance knee, a few degrees at most."""
     kp = servo_stiffness_nm_per_rad(OP3)
-    assert kp == pytest.approx(4.1 / math.radians(6.0))  # XM430-W350 stall torque over the written 6 deg
+    # XM430-W350 stall torque over the written 6 deg, within the register's whole step (Position P Gain 1659
+    # holds 6.0014 deg; tests/robot/test_robot_servo_gains.py holds the exact value)
+    assert kp == pytest.approx(4.1 / math.radians(6.0), rel=1e-3)
     offset = np.degrees(walk.goals_rad - walk.q_rad)
     assert 0.5 < np.abs(offset).max() < 3.0
     knees = [LEG_JOINTS.index("knee_pitch_left"), LEG_JOINTS.index("knee_pitch_right")]
