@@ -143,9 +143,18 @@ def _leg(side: str, y_m: float, g: Geometry, config: RobotConfig, drives: dict[s
     </body>"""
 
 
-def world_head(timestep: float) -> str:
-    """The MJCF both models share up to the robot: solver options, the contact defaults and the floor."""
-    return f"""  <compiler angle="degree" autolimits="true"/>
+def mjcf_document(name: str, timestep: float, drives, torso: str, number=_f) -> str:
+    """The MJCF both models share around the robot: solver options, contact defaults, the floor, one
+    position actuator per servo (``drives``, in actuator order), the soles' touch sensors; ``torso`` is the
+    robot's body element, legs included; ``number`` writes the actuators' numbers (the 3D model keeps more
+    digits)."""
+    actuators = "\n    ".join(
+        f'<position name="{d.name}" joint="{d.name}" kp="{number(d.kp_nm_per_rad)}" '
+        f'forcerange="{number(-d.stall_torque_nm, d.stall_torque_nm)}" '
+        f'ctrlrange="{number(math.radians(d.min_deg), math.radians(d.max_deg))}"/>' for d in drives)
+    sensors = "\n    ".join(f'<touch name="touch_{side}" site="touch_{side}"/>' for side in SIDES)
+    return f"""<mujoco model="{name}">
+  <compiler angle="degree" autolimits="true"/>
   <option timestep="{_f(timestep)}" integrator="implicitfast" cone="elliptic" impratio="{_f(IMPRATIO)}"/>
   <visual><global offwidth="640" offheight="480"/></visual>
   <default>
@@ -159,6 +168,15 @@ def world_head(timestep: float) -> str:
   <worldbody>
     <light pos="0 -2 3" dir="0 1 -1.5" directional="true"/>
     <geom name="floor" type="plane" size="0 0 0.05" material="grid" contype="1" conaffinity="2"/>
+    {torso}
+  </worldbody>
+  <actuator>
+    {actuators}
+  </actuator>
+  <sensor>
+    {sensors}
+  </sensor>
+</mujoco>
 """
 
 
@@ -175,26 +193,12 @@ def build_mjcf(config: RobotConfig, rate_hz: float, free_pitch: bool = False) ->
     radius = 0.1 * leg_length / 2
     torso_half = (max(g.foot_m / 3, 0.02), g.hip_width_m / 2 + radius, torso_h / 2)
     pitch = '<joint name="boom_pitch" type="hinge" axis="0 1 0"/>' if free_pitch else ""
-    actuators = "\n    ".join(
-        f'<position name="{d.name}" joint="{d.name}" kp="{_f(d.kp_nm_per_rad)}" '
-        f'forcerange="{_f(-d.stall_torque_nm, d.stall_torque_nm)}" ctrlrange="{_f(math.radians(d.min_deg), math.radians(d.max_deg))}"/>'
-        for d in drives.values())
-    sensors = "\n    ".join(f'<touch name="touch_{side}" site="touch_{side}"/>' for side in SIDES)
     legs = "".join(_leg(side, y, g, config, drives) for side, y in zip(SIDES, (g.hip_width_m / 2, -g.hip_width_m / 2)))
-    return f"""<mujoco model="{config.name}">
-{world_head(timestep)}    <body name="torso" pos="0 0 {_f(leg_length + g.ankle_height_m)}">
+    torso = f"""<body name="torso" pos="0 0 {_f(leg_length + g.ankle_height_m)}">
       <joint name="boom_x" type="slide" axis="1 0 0"/>
       <joint name="boom_z" type="slide" axis="0 0 1"/>
       {pitch}
       <geom name="torso" type="box" pos="0 0 {_f(torso_half[2] + radius)}" size="{_f(*torso_half)}" mass="{_f(config.mass.torso_kg)}" rgba="0.3 0.45 0.7 1"/>
       {legs}
-    </body>
-  </worldbody>
-  <actuator>
-    {actuators}
-  </actuator>
-  <sensor>
-    {sensors}
-  </sensor>
-</mujoco>
-"""
+    </body>"""
+    return mjcf_document(config.name, timestep, drives.values(), torso)

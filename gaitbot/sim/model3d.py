@@ -18,14 +18,13 @@ P loop with back-EMF damping and the gearbox's armature, stiff contacts, <= 1 ms
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
 from gaitbot.gait.body import LEG_LINKS, SIDE_SIGN
 from gaitbot.gait.joints import LEG_JOINT_KINDS, SIDES
 from gaitbot.robot.config import RobotConfig
-from gaitbot.sim.model import LEG_RGBA, SOLE_THICKNESS_M, JointDrive, substeps_per_frame, world_head
+from gaitbot.sim.model import LEG_RGBA, SOLE_THICKNESS_M, JointDrive, mjcf_document, substeps_per_frame
 
 SUPPORTS = ("free", "boom", "boom-pitch")
 MIN_MOVING_LINK_KG = 1e-4  # MuJoCo needs mass on a body that moves; a massless link of a pitch-only leg gets this
@@ -111,25 +110,11 @@ def build_mjcf_3d(config: RobotConfig, drives: tuple[JointDrive, ...], rate_hz: 
     else:
         root_joints = ('<joint name="boom_x" type="slide" axis="1 0 0"/><joint name="boom_z" type="slide" axis="0 0 1"/>'
                        + ('<joint name="boom_pitch" type="hinge" axis="0 1 0"/>' if support == "boom-pitch" else ""))
-    actuators = "\n    ".join(
-        f'<position name="{d.name}" joint="{d.name}" kp="{_f(d.kp_nm_per_rad)}" '
-        f'forcerange="{_f(-d.stall_torque_nm, d.stall_torque_nm)}" '
-        f'ctrlrange="{_f(math.radians(d.min_deg), math.radians(d.max_deg))}"/>' for d in drives)
-    sensors = "\n    ".join(f'<touch name="touch_{side}" site="touch_{side}"/>' for side in SIDES)
     legs = "".join(_leg(config, side, by_name) for side in SIDES)
-    return f"""<mujoco model="{config.name}">
-{world_head(timestep)}    <body name="torso" pos="0 0 {_f(g.standing_root_height_m)}">
+    torso = f"""<body name="torso" pos="0 0 {_f(g.standing_root_height_m)}">
       {root_joints}
       {_inertial(config.body.torso, True)}
       <geom name="torso" type="box" pos="0 0 {_f(torso_centre_z)}" size="{_f(*torso_half)}" mass="0" rgba="0.3 0.45 0.7 1"/>
       {legs}
-    </body>
-  </worldbody>
-  <actuator>
-    {actuators}
-  </actuator>
-  <sensor>
-    {sensors}
-  </sensor>
-</mujoco>
-"""
+    </body>"""
+    return mjcf_document(config.name, timestep, drives, torso, number=_f)
