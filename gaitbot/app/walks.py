@@ -97,10 +97,10 @@ def balanced_plan(source: GaitSource, steps, max_step_m: float | None = None) ->
     return plan_balanced(source.robot, steps, gait)
 
 
-def speed_fit_note(walker) -> str | None:
+def speed_fit_note(plan: BalancedPlan) -> str | None:
     """One line when a balanced walk's settings were relaxed to fit the servos' speed (else None)."""
-    fit = getattr(walker, "fit", None)
-    if fit is None or fit.relaxed == 0:
+    fit = plan.fit
+    if fit.relaxed == 0:
         return None
     b, g = fit.balance, fit.gait
     return (f"the servos' max_velocity_dps ({fit.limit_dps:g}) needed a gentler walk at this cycle and step: crouch "
