@@ -1,0 +1,75 @@
+"""What every command source gives the drive loop each frame, the watchdog, and ``--input`` parsing."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+from gaitbot.errors import UserError
+from gaitbot.gait.steer.command import STILL, VelocityCommand
+
+WATCHDOG_S = 0.5  # a network or gamepad source silent this long stops the walk (to standing)
+
+
+class InputError(UserError, ValueError):
+    """An ``--input`` that cannot be opened (a bad spec, a port in use, no gamepad)."""
+
+
+@dataclass
+class Reading:
+    """A source's state after a poll: the command in force (the last one holds), whether the user asked to end
+    the drive, and any messages for the user (each said once by the source)."""
+
+    command: VelocityCommand = STILL
+    end: bool = False
+    messages: list[str] = field(default_factory=list)
+
+
+class CommandSource(Protocol):
+    """Polled once a frame; never blocks."""
+
+    name: str
+
+    def poll(self, now_s: float) -> Reading:
+        """The state at ``now_s`` (seconds on the drive's clock, from its start)."""
+
+    def close(self) -> None:
+        """Give back what the source holds (terminal mode, socket, device)."""
+
+
+class Watchdog:
+    """Silence detector: ``expired`` once ``limit_s`` has passed since the last ``feed``.
+
+    Why: a network sender or a wireless gamepad can vanish mid-walk; the walk must then come to standing
+    rather than keep obeying the last command for ever."""
+
+    def __init__(self, limit_s: float = WATCHDOG_S) -> None:
+        self.limit_s = limit_s
+        self.last_fed_s: float | None = None
+
+    def feed(self, now_s: float) -> None:
+        self.last_fed_s = now_s
+
+    def expired(self, now_s: float) -> bool:
+        return self.last_fed_s is not None and now_s - self.last_fed_s > self.limit_s
+
+
+def open_source(spec: str, max_command: VelocityCommand, min_command: VelocityCommand) -> CommandSource:
+    """``--input``: ``keyboard``, ``gamepad[:DEVICE]``, ``udp:[HOST:]PORT`` or ``commands:FILE``.
+
+    max_command and min_command are the robot's most forward/left/counter-clockwise and most
+    backward/right/clockwise command (the keyboard and the gamepad scale to them)."""
+    kind, _, rest = spec.partition(":")
+    if kind == "keyboard" and not rest:
+        from gaitbot.inputs.keyboard import KeyboardSource
+        return KeyboardSource.on_terminal(max_command, min_command)
+    if kind == "gamepad":
+        from gaitbot.inputs.gamepad import GamepadSource
+        return GamepadSource.open(rest or None, max_command, min_command)
+    if kind == "udp" and rest:
+        from gaitbot.inputs.udp import UdpSource
+        return UdpSource.bind(rest)
+    if kind == "commands" and rest:
+        from gaitbot.inputs.scripted import ScriptedSource
+        return ScriptedSource.from_file(rest)
+    raise InputError(f"--input: expected keyboard, gamepad[:DEVICE], udp:[HOST:]PORT or commands:FILE, got {spec!r}")
