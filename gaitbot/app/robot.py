@@ -75,9 +75,6 @@ def import_description(args) -> int:
     mapping = read_map(file_option(args.map, "--map")) if args.map is not None else None
     tree = read_description(source)
     legs = leg_joints(tree, mapping)
-    print(f"# joints found in {source.name} (gaitbot joint = description joint; '-': opposite sense). "
-          f"Check them; save this as a --map file to change them:")
-    print(mapping_text(legs), end="")
     imported = import_tree(tree, legs)
     text = draft_text(out.stem, source.name, imported, like)
     write_output(out, lambda path: path.write_text(text))
@@ -94,6 +91,9 @@ def import_description(args) -> int:
         raise DescriptionError(source, "joints", f"gaitbot's leg model with this mapping misses the description's "
                                                  f"knees, ankles or feet by {deviation * 1000:.1f} mm at random poses "
                                                  f"(leg {leg_m * 1000:.0f} mm): wrong joints? give a --map file")
+    print(f"# joints found in {source.name} (gaitbot joint = description joint; '-': opposite sense). "
+          f"Check them; save this as a --map file to change them:")
+    print(mapping_text(legs), end="")
     for note in imported.notes:
         print(f"note: {note}", file=sys.stderr)
     print(f"wrote {out}: {config.name}, {len(legs['left'])} joints a leg, {config.body.total_kg:.6g} kg; forward "
