@@ -113,7 +113,8 @@ def leg_joints(tree: Tree, mapping=None) -> dict[str, list[LegJoint]]:
         if not kinds[side]:
             raise tree.fail("joints", f"no joint's name says it is a {side} leg joint (hinges: "
                                       f"{', '.join(list(tree.hinges)[:30])}): give a --map file")
-        if tuple(kinds[side]) not in (LEG_JOINT_KINDS, PITCH_KINDS) or kinds[side] != kinds[SIDES[1 - SIDES.index(side)]]:
+        other = kinds[SIDES[1 - SIDES.index(side)]]
+        if tuple(kinds[side]) not in (LEG_JOINT_KINDS, PITCH_KINDS) or kinds[side] != other:
             raise tree.fail(f"{side} leg", f"{len(kinds[side])} joints found ({', '.join(kinds[side])}); gaitbot's "
                                            f"legs have 6 (hip yaw, roll, pitch, knee, ankle pitch, roll) or 3 (hip, "
                                            f"knee, ankle pitch), both legs alike")
@@ -138,7 +139,8 @@ def _sensed(tree: Tree, frames, ours: str, named: tuple[str, int | None]) -> Leg
     dot = float(np.dot(axis, joint_axis(*split_joint(ours))))
     error = math.degrees(math.acos(min(1.0, abs(dot))))
     if error > AXIS_TOLERANCE_DEG:
-        raise tree.fail(f"joint {theirs}", f"taken for gaitbot's {ours}, but its axis ({', '.join(f'{a:.3f}' for a in axis)}) "
+        shown = ", ".join(f"{a:.3f}" for a in axis)
+        raise tree.fail(f"joint {theirs}", f"taken for gaitbot's {ours}, but its axis ({shown}) "
                                            f"in the root frame is {error:.1f} deg from gaitbot's "
                                            f"{joint_axis(*split_joint(ours))} (at most {AXIS_TOLERANCE_DEG:g})")
     sign = 1 if dot > 0 else -1

@@ -21,6 +21,8 @@ from gaitbot.gait.body import LinkInertial
 MAX_BODIES = 2000
 #: The largest description file read (bytes): the shipped and Menagerie files are ~10-100 KB without meshes.
 MAX_DESCRIPTION_BYTES = 8 * 2**20
+#: No number of a robot description means anything beyond this (metres, kilograms, kg m^2, radians).
+MAX_MAGNITUDE = 1e6
 
 
 class DescriptionError(FieldError):
@@ -131,9 +133,14 @@ def ordered(path: str, bodies: list[Body]) -> tuple[dict[str, Body], str]:
     for b in bodies:
         if b.parent is not None and b.parent not in by_name:
             raise DescriptionError(path, b.name, f"its parent {b.parent!r} does not exist")
-    if len(roots) != 1:
-        what = ", ".join(roots[:5]) if roots else "none (every link has a parent: a cycle)"
-        raise DescriptionError(path, "file", f"a robot is one tree with one root link; roots found: {what}")
+        numbers = np.concatenate([b.position_m, np.ravel(b.rotation)])
+        if not np.all(np.isfinite(numbers)) or np.abs(numbers).max() > MAX_MAGNITUDE:
+            raise DescriptionError(path, b.name, f"its place is not finite or beyond {MAX_MAGNITUDE:g} m")
+    if not roots:
+        raise DescriptionError(path, "file", "every link has a parent: the links form a cycle, a robot is a tree")
+    if len(roots) > 1:
+        raise DescriptionError(path, "file", f"{len(roots)} links have no parent joint ({', '.join(roots[:5])}): a "
+                                             f"missing joint? a robot description is one tree")
     children: dict[str, list[str]] = {}
     for b in bodies:
         if b.parent is not None:
@@ -154,8 +161,8 @@ def ordered(path: str, bodies: list[Body]) -> tuple[dict[str, Body], str]:
 def checked_inertial(path: str, where: str, mass_kg: float, com_m, inertia) -> LinkInertial:
     """A body's inertial, refused unless its mass is positive and its numbers finite."""
     values = np.concatenate([[mass_kg], np.ravel(com_m), np.ravel(inertia)])
-    if not np.all(np.isfinite(values)):
-        raise DescriptionError(path, where, "inertial: a number is not finite")
+    if not np.all(np.isfinite(values)) or np.abs(values).max() > MAX_MAGNITUDE:
+        raise DescriptionError(path, where, f"inertial: a number is not finite or beyond {MAX_MAGNITUDE:g}")
     if not mass_kg > 0:
         raise DescriptionError(path, where, f"mass {mass_kg:g} kg: a body's mass must be positive "
                                             f"(leave the inertial out for a massless frame)")

@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from gaitbot.fields import read_user_file
-from gaitbot.robot.description.tree import (MAX_BODIES, MAX_DESCRIPTION_BYTES, Body, Box, DescriptionError, Hinge,
-                                            Tree, checked_inertial, ordered, rpy_matrix)
+from gaitbot.robot.description.tree import (MAX_BODIES, MAX_DESCRIPTION_BYTES, MAX_MAGNITUDE, Body, Box,
+                                            DescriptionError, Hinge, Tree, checked_inertial, ordered, rpy_matrix)
 
 HINGE_TYPES = ("revolute", "continuous")
 
@@ -57,8 +57,9 @@ class _Reader:
             values = np.array([float(v) for v in text.split()], dtype=float)
         except ValueError:
             raise self.fail(where, f"{key}={text[:40]!r} is not {count} number{'s' if count > 1 else ''}") from None
-        if len(values) != count or not np.all(np.isfinite(values)):
-            raise self.fail(where, f"{key}={text[:40]!r}: expected {count} finite number{'s' if count > 1 else ''}")
+        if len(values) != count or not np.all(np.isfinite(values)) or np.abs(values).max() > MAX_MAGNITUDE:
+            raise self.fail(where, f"{key}={text[:40]!r}: expected {count} finite number{'s' if count > 1 else ''} "
+                                   f"within +-{MAX_MAGNITUDE:g}")
         return values
 
     def origin(self, element: ET.Element, where: str) -> tuple[np.ndarray, np.ndarray]:
