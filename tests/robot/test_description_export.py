@@ -85,9 +85,10 @@ def test_urdf_forward_kinematics_masses_and_centre_of_mass_are_the_configs(tmp_p
 
 
 def test_urdf_frames_for_other_tools_are_there(tmp_path):
-    """REP-120's base_link and soles, PlaCo's trunk and feet (docs/robot-description.md)."""
+    """REP-120's base_link and soles, PlaCo's trunk, feet and hips (docs/robot-description.md)."""
     _, urdf = load(tmp_path, "op3")
-    for frame in ("base_link", "torso", "trunk", "l_sole", "r_sole", "left_foot", "right_foot"):
+    for frame in ("base_link", "torso", "trunk", "l_sole", "r_sole", "left_foot", "right_foot", "left_hip_yaw",
+                  "right_hip_yaw"):
         assert frame in urdf.link_map, frame
     assert np.allclose(urdf.get_transform("left_foot", "base_link"), urdf.get_transform("l_sole", "base_link"))
 
@@ -99,3 +100,14 @@ def test_urdf_limits_and_the_held_joint(tmp_path):
         assert (limit.lower, limit.upper) == pytest.approx((math.radians(joint.min_deg), math.radians(joint.max_deg)))
     held = config.held_joints[0]
     assert urdf.joint_map[held.name].type == "fixed"
+
+
+def test_placo_reads_the_urdf_with_its_frames(tmp_path):
+    """PlaCo (Rhoban's walking library, the benchmark extra) takes the exported URDF as a HumanoidRobot: its
+    trunk-to-hip spacing and its mass are the config's."""
+    placo = pytest.importorskip("placo")
+    config, _ = load(tmp_path, "op3")
+    robot = placo.HumanoidRobot(str(tmp_path / "op3.urdf"))
+    hip = robot.get_T_a_b("trunk", "left_hip_yaw")[:3, 3]
+    assert np.allclose(hip, config.body.geometry.hip_in_root("left"), atol=1e-12)
+    assert robot.total_mass() == pytest.approx(config.body.total_kg, abs=1e-9)

@@ -9,7 +9,8 @@ at 0 (the link stays, massless, so every robot has the same frames). Masses, cen
 are ``config.body``'s. The feet are boxes (collision and visual) from the sole to the ankle point; thigh,
 shank and torso get simple visual shapes. Frames for other tools, all fixed (docs/robot-description.md):
 ``base_link`` (the root, REP-120), ``torso`` (its mass), ``trunk`` (PlaCo's name for the root),
-``l_sole``/``r_sole`` (REP-120) and ``left_foot``/``right_foot`` (PlaCo) at each sole's centre, z up.
+``l_sole``/``r_sole`` (REP-120) and ``left_foot``/``right_foot`` (PlaCo) at each sole's centre, z up, and
+``left_hip_yaw``/``right_hip_yaw`` (PlaCo) at the hip points.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ ROOT_LINK = "base_link"
 TORSO_LINK = "torso"
 ALIAS_FRAMES = {"trunk": ROOT_LINK}
 SOLE_FRAMES = {"left": ("l_sole", "left_foot"), "right": ("r_sole", "right_foot")}
+HIP_FRAMES = {"left": "left_hip_yaw", "right": "right_hip_yaw"}  # PlaCo measures the legs' spacing between these
 MIN_FOOT_BOX_M = 0.004  # a foot box at least this tall, when the sole is at the ankle axis
 COLOURS = {"left": "0.45 0.5 0.6 1", "right": "0.9 0.6 0.2 1", "torso": "0.3 0.45 0.7 1", "sole": "0.2 0.2 0.25 1"}
 
@@ -97,6 +99,8 @@ def _leg(config: RobotConfig, side: str) -> list[str]:
                        f'upper="{_f(math.radians(joint.max_deg))}" effort="{_f(effort)}" '
                        f'velocity="{_f(math.radians(joint.max_velocity_dps))}"/></joint>')
         parent = child
+    out.append(f'<link name="{HIP_FRAMES[side]}"/>' + _fixed(f"{HIP_FRAMES[side]}_frame", f"hip_yaw_{side}",
+                                                             HIP_FRAMES[side]))
     sole = g.sole_centre_in_foot(side)
     for frame in SOLE_FRAMES[side]:
         out.append(f'<link name="{frame}"/>' + _fixed(f"{frame}_frame", parent, frame, sole))
