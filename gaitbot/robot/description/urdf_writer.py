@@ -21,16 +21,11 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from gaitbot.gait.body import LEG_LINKS
-from gaitbot.gait.joints import LEG_JOINT_KINDS, SIDES
-from gaitbot.gait.kinematics6 import joint_axis
+from gaitbot.gait.joints import SIDES
 from gaitbot.robot.config import RobotConfig
-from gaitbot.robot.description.tree import axis_angle, matrix_rpy
+from gaitbot.robot.description.frames import ROOT_LINK, TORSO_LINK, JointFrame, joint_frames
+from gaitbot.robot.description.tree import matrix_rpy
 
-ROOT_LINK = "base_link"
-TORSO_LINK = "torso"
-ALIAS_FRAMES = {"trunk": ROOT_LINK}
-SOLE_FRAMES = {"left": ("l_sole", "left_foot"), "right": ("r_sole", "right_foot")}
-HIP_FRAMES = {"left": "left_hip_yaw", "right": "right_hip_yaw"}  # PlaCo measures the legs' spacing between these
 MIN_FOOT_BOX_M = 0.004  # a foot box at least this tall, when the sole is at the ankle axis
 COLOURS = {"left": "0.45 0.5 0.6 1", "right": "0.9 0.6 0.2 1", "torso": "0.3 0.45 0.7 1", "sole": "0.2 0.2 0.25 1"}
 
@@ -78,33 +73,28 @@ def _leg_shapes(config: RobotConfig, side: str) -> dict[str, str]:
     }
 
 
-def _leg(config: RobotConfig, side: str) -> list[str]:
-    g = config.body.geometry
-    joints = {j.name: j for j in config.joints}
-    shapes = _leg_shapes(config, side)
-    offsets = {"hip_yaw": g.hip_in_root(side), "shank": (0, 0, -g.thigh_m), "ankle": (0, 0, -g.shank_m)}
-    parent, out = ROOT_LINK, []
-    for kind, link in zip(LEG_JOINT_KINDS, LEG_LINKS):
-        name, child = f"{kind}_{side}", f"{link}_{side}"
-        xyz, joint = offsets.get(link, (0, 0, 0)), joints.get(f"{kind}_{side}")
-        out.append(f'<link name="{child}">{_inertial(config.body.leg_link(link, side))}{shapes.get(link, "")}</link>')
-        axis = joint_axis(kind, side)
-        if joint is None or joint.hold_deg is not None:
-            hold = math.radians(joint.hold_deg) if joint is not None else 0.0
-            out.append(_fixed(name, parent, child, xyz, matrix_rpy(axis_angle(axis, hold))))
-        else:
-            effort = joint.model.stall_torque_nm
-            out.append(f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
-                       f'{_origin(xyz)}<axis xyz="{_f(*axis)}"/><limit lower="{_f(math.radians(joint.min_deg))}" '
-                       f'upper="{_f(math.radians(joint.max_deg))}" effort="{_f(effort)}" '
-                       f'velocity="{_f(math.radians(joint.max_velocity_dps))}"/></joint>')
-        parent = child
-    out.append(f'<link name="{HIP_FRAMES[side]}"/>' + _fixed(f"{HIP_FRAMES[side]}_frame", f"hip_yaw_{side}",
-                                                             HIP_FRAMES[side]))
-    sole = g.sole_centre_in_foot(side)
-    for frame in SOLE_FRAMES[side]:
-        out.append(f'<link name="{frame}"/>' + _fixed(f"{frame}_frame", parent, frame, sole))
-    return out
+def _joint(config: RobotConfig, frame: JointFrame) -> str:
+    ends = f'<parent link="{frame.parent}"/><child link="{frame.child}"/>'
+    if not frame.moving:
+        origin = _origin(frame.origin_m, matrix_rpy(frame.transform()[1]))
+        return f'<joint name={quoteattr(frame.name)} type="fixed">{ends}{origin}</joint>'
+    joint = config.joint(frame.name)
+    return (f'<joint name="{frame.name}" type="revolute">{ends}{_origin(frame.origin_m)}<axis xyz="{_f(*frame.axis)}"/>'
+            f'<limit lower="{_f(math.radians(joint.min_deg))}" upper="{_f(math.radians(joint.max_deg))}" '
+            f'effort="{_f(joint.model.stall_torque_nm)}" velocity="{_f(math.radians(joint.max_velocity_dps))}"/>'
+            f'</joint>')
+
+
+def _link(config: RobotConfig, name: str, shapes: dict[str, str]) -> str:
+    """A link: its inertial (the torso's, a leg link's, none for a frame) and its shapes."""
+    link, _, side = name.rpartition("_")
+    inertial = ""
+    if name == TORSO_LINK:
+        inertial = _inertial(config.body.torso)
+    elif side in SIDES and link in LEG_LINKS:
+        inertial = _inertial(config.body.leg_link(link, side))
+    return f'<link name="{name}">{inertial}{shapes.get(name, "")}</link>' if inertial or name in shapes \
+        else f'<link name="{name}"/>'
 
 
 def urdf_text(config: RobotConfig) -> str:
@@ -112,15 +102,13 @@ def urdf_text(config: RobotConfig) -> str:
     g = config.body.geometry
     radius = 0.055 * g.leg_length_m
     torso_half = (max(g.foot_m / 3, 0.02), g.hip_width_m / 2 + radius, 0.3 * g.leg_length_m)
-    torso_shape = _shape("box", f'size="{_f(*(2 * np.array(torso_half)))}"',
-                         (0, 0, torso_half[2] - g.hip_below_root_m), COLOURS["torso"])
-    parts = [f'<link name="{ROOT_LINK}"/>',
-             f'<link name="{TORSO_LINK}">{_inertial(config.body.torso)}{torso_shape}</link>',
-             _fixed(f"{TORSO_LINK}_frame", ROOT_LINK, TORSO_LINK)]
-    for alias, target in ALIAS_FRAMES.items():
-        parts += [f'<link name="{alias}"/>', _fixed(f"{alias}_frame", target, alias)]
+    shapes = {TORSO_LINK: _shape("box", f'size="{_f(*(2 * np.array(torso_half)))}"',
+                                 (0, 0, torso_half[2] - g.hip_below_root_m), COLOURS["torso"])}
     for side in SIDES:
-        parts += _leg(config, side)
+        shapes.update({f"{link}_{side}": text for link, text in _leg_shapes(config, side).items()})
+    parts = [f'<link name="{ROOT_LINK}"/>']
+    for frame in joint_frames(config):
+        parts += [_link(config, frame.child, shapes), _joint(config, frame)]
     body = "\n  ".join(parts)
     return (f'<?xml version="1.0"?>\n<!-- {config.name}: written by gaitbot robot export from {config.path.name} '
             f'(frames: docs/robot-description.md) -->\n<robot name={quoteattr(config.name)}>\n  {body}\n</robot>\n')
