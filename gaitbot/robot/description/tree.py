@@ -197,3 +197,21 @@ def matrix_rpy(r: np.ndarray) -> tuple[float, float, float]:
     """The URDF rpy of a rotation matrix (inverse of rpy_matrix away from pitch +-90 deg)."""
     pitch = float(np.arcsin(np.clip(-r[2, 0], -1.0, 1.0)))
     return float(np.arctan2(r[2, 1], r[2, 2])), pitch, float(np.arctan2(r[1, 0], r[0, 0]))
+
+
+def matrix_quaternion(r: np.ndarray) -> tuple[float, float, float, float]:
+    """The unit quaternion (w, x, y, z) of a rotation matrix (the inverse of quaternion_matrix, w >= 0)."""
+    trace = r[0, 0] + r[1, 1] + r[2, 2]
+    if trace > 0:
+        s = 2.0 * np.sqrt(1.0 + trace)
+        q = (0.25 * s, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s)
+    else:
+        i = int(np.argmax([r[0, 0], r[1, 1], r[2, 2]]))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * np.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k])
+        v = [0.0, 0.0, 0.0]
+        v[i], v[j], v[k] = 0.25 * s, (r[j, i] + r[i, j]) / s, (r[k, i] + r[i, k]) / s
+        q = ((r[k, j] - r[j, k]) / s, *v)
+    q = np.array(q, dtype=float)
+    q = q if q[0] >= 0 else -q
+    return tuple(float(v) for v in q / np.linalg.norm(q))  # type: ignore[return-value]
