@@ -75,10 +75,28 @@ def _hinge(mujoco, model, b: int, name: str, path: Path) -> Hinge | None:
                  np.array(model.jnt_pos[j], dtype=float), bounds)
 
 
+def _check_masses(root, path: Path) -> None:
+    """An inertial's mass must be positive (MuJoCo takes 0 on a body whose children carry mass, and says less
+    clearly what is wrong with a negative one); a geom's may be 0 (shapes that only collide), never negative."""
+    for body in root.iter("body"):
+        name = body.get("name") or "(unnamed body)"
+        checks = [(body.find("inertial"), "positive")] + [(g, "not negative") for g in body.findall("geom")]
+        for element, least in checks:
+            if element is None or element.get("mass") is None:
+                continue
+            try:
+                mass = float(element.get("mass"))
+            except ValueError:
+                raise DescriptionError(path, f"body {name}", f"mass {element.get('mass')[:40]!r} is not a number") \
+                    from None
+            if not (mass > 0 if least == "positive" else mass >= 0):
+                raise DescriptionError(path, f"body {name}", f"{element.tag} mass {mass:g} kg: must be {least}")
+
+
 def read_mjcf(path: str | Path) -> Tree:
     """The MJCF file at ``path`` as a description tree; DescriptionError (one line) when it cannot be one."""
     path = Path(path)
-    read_xml(path)  # the size cap and the entity refusal before MuJoCo reads it
+    _check_masses(read_xml(path), path)  # the size cap, the entity refusal and the masses before MuJoCo reads it
     mujoco, model = _compile(path)
     if model.nbody > MAX_BODIES:
         raise DescriptionError(path, "file", f"{model.nbody} bodies, more than a robot has (at most {MAX_BODIES})")

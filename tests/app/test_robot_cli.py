@@ -118,3 +118,36 @@ def test_a_draft_plans_and_simulates_but_hardware_refuses_it(tmp_path, capsys):
 def test_export_needs_an_output(tmp_path, capsys):
     code, _, err = run_cli(capsys, "robot", "export", "op3")
     assert code == 2 and "--urdf" in err
+
+
+@pytest.fixture(scope="module")
+def menagerie_mjcf() -> str:
+    import sys
+
+    from helpers import REPO_ROOT
+
+    from gaitbot.sim import SimUnavailable, import_mujoco
+
+    try:
+        import_mujoco()
+    except SimUnavailable:
+        pytest.skip("the sim extra (MuJoCo) is not installed")
+    sys.path.insert(0, str(REPO_ROOT / "tools"))
+    import op3_menagerie
+
+    return op3_menagerie.menagerie_mjcf()
+
+
+@pytest.mark.parametrize("mass, words", [("0", "inertial mass 0 kg: must be positive"),
+                                         ("-0.04", "inertial mass -0.04 kg: must be positive")])
+def test_an_mjcf_by_other_authors_with_a_bad_mass_is_refused(tmp_path, menagerie_mjcf, mass, words):
+    text = re.sub(r'(<body name="l_knee_link"[^>]*><inertial[^>]*mass=")[^"]*', rf"\g<1>{mass}", menagerie_mjcf)
+    err = refused(tmp_path, "op3.xml", text, "--like", "op3")
+    assert "body l_knee_link" in err and words in err
+
+
+def test_an_mjcf_leg_without_its_knee_is_refused(tmp_path, menagerie_mjcf):
+    text = re.sub(r'<joint name="l_knee"[^>]*/>', "", menagerie_mjcf).replace('<position name="l_knee_act" '
+                                                                             'joint="l_knee"/>', "")
+    err = refused(tmp_path, "op3.xml", text, "--like", "op3")
+    assert "left leg: 5 joints found (hip_yaw, hip_roll, hip_pitch, ankle_pitch, ankle_roll)" in err
