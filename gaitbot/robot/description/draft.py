@@ -99,8 +99,8 @@ def draft_text(name: str, source: str, imported: Imported, like: RobotConfig | N
     three_d = len(legs["left"]) == 6
     g = imported.geometry
     header = [f"# {name}: imported by gaitbot robot import from {source}",
-              "# Joint mapping (gaitbot joint = description joint, '-': opposite sense): "
-              + ", ".join(f"{k} = {v}" for k, v in mapped.items())]
+              "# Joint mapping (gaitbot joint = description joint, '-': opposite sense; a --map file's form):"]
+    header += ["#   " + ", ".join(f"{j.name} = {mapped[j.name]}" for j in legs[side]) for side in legs]
     header += [f"# Left out by gaitbot's leg model: {note}" for note in imported.notes[:20]] + [""]
     robot = {"name": name, "boom": like.boom if like is not None else not three_d}
     if like is None:
