@@ -64,7 +64,7 @@ def import_description(args) -> int:
     from gaitbot.robot.config import ConfigError, load_robot_config
     from gaitbot.robot.description.chains import leg_joints, mapping_text, read_map
     from gaitbot.robot.description.draft import draft_text
-    from gaitbot.robot.description.importer import FK_REFUSE_SHARE_OF_LEG, fk_deviation_m, import_tree
+    from gaitbot.robot.description.importer import FK_REFUSE_SHARE_OF_LEG, SOLE_KEYS, fk_deviation_m, import_tree
     from gaitbot.robot.description.tree import DescriptionError
     from gaitbot.sim.description import read_description
 
@@ -75,7 +75,8 @@ def import_description(args) -> int:
     mapping = read_map(file_option(args.map, "--map")) if args.map is not None else None
     tree = read_description(source)
     legs = leg_joints(tree, mapping)
-    imported = import_tree(tree, legs)
+    sole = {key: getattr(like.body.geometry, key) for key in SOLE_KEYS} if like is not None else None
+    imported = import_tree(tree, legs, sole)
     text = draft_text(out.stem, source.name, imported, like)
     write_output(out, lambda path: path.write_text(text))
     try:

@@ -151,3 +151,15 @@ def test_an_mjcf_leg_without_its_knee_is_refused(tmp_path, menagerie_mjcf):
                                                                              'joint="l_knee"/>', "")
     err = refused(tmp_path, "op3.xml", text, "--like", "op3")
     assert "left leg: 5 joints found (hip_yaw, hip_roll, hip_pitch, ankle_pitch, ankle_roll)" in err
+
+
+def test_feet_without_boxes_take_the_like_configs_sole_or_are_refused(tmp_path, capsys, op3_urdf):
+    """A description whose feet are meshes only (a CAD export): with --like the sole is that config's (and a
+    note says so); without, the import is refused naming the foot."""
+    text = re.sub(r"<collision>.*?</collision>", "", op3_urdf)
+    assert "<collision>" not in text
+    assert "no box collision shape on the left foot" in refused(tmp_path, "meshes.urdf", text)
+    out = tmp_path / "sole.toml"
+    code, _, err = run_cli(capsys, "robot", "import", tmp_path / "meshes.urdf", "--like", "op3", "-o", out)
+    assert code == 0 and "the sole is the --like config's" in err
+    assert load_robot_config(out).geometry == load_robot_config(resolve_config("op3")).geometry

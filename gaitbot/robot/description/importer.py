@@ -107,8 +107,12 @@ def _lump(parts: list[tuple[float, np.ndarray, np.ndarray]]) -> LinkInertial:
     return LinkInertial(float(mass), com, inertia)
 
 
-def import_tree(tree: Tree, legs: dict[str, list[LegJoint]]) -> Imported:
-    """The description in gaitbot's terms; DescriptionError where it cannot be gaitbot's leg model."""
+SOLE_KEYS = ("foot_m", "foot_width_m", "ankle_height_m", "heel_back_m", "sole_outward_m")
+
+
+def import_tree(tree: Tree, legs: dict[str, list[LegJoint]], sole_m: dict | None = None) -> Imported:
+    """The description in gaitbot's terms; DescriptionError where it cannot be gaitbot's leg model. ``sole_m``
+    (SOLE_KEYS, e.g. a --like config's) stands in for a sole the description has no box for (meshes only)."""
     frames = tree.frames()
     lines = _joint_lines(tree, frames, legs)
     points = {side: _points(lines[side]) for side in SIDES}
@@ -118,8 +122,9 @@ def import_tree(tree: Tree, legs: dict[str, list[LegJoint]]) -> Imported:
                                     f"along the root's y (REP-103: x forward, y left, z up)")
     origin = np.array([hips[:, 0].mean(), hips[:, 1].mean(), max(0.0, hips[:, 2].mean())])
     points = {s: {k: v - origin for k, v in points[s].items()} for s in SIDES}
-    notes = []
-    geometry = _geometry(tree, points, legs, frames, origin, notes)
+    notes = [f"{j.name}: axis {j.axis_error_deg:.2f} deg off gaitbot's (taken as gaitbot's)"
+             for side in SIDES for j in legs[side] if j.axis_error_deg > 0.01]
+    geometry = _geometry(tree, points, legs, frames, origin, notes, sole_m)
     links = _links(tree, legs, frames, origin, points, notes)
     limits = {}
     for side in SIDES:
@@ -130,7 +135,7 @@ def import_tree(tree: Tree, legs: dict[str, list[LegJoint]]) -> Imported:
     return Imported(geometry, links, limits, legs, origin, notes)
 
 
-def _geometry(tree, points, legs, frames, origin, notes) -> dict:
+def _geometry(tree, points, legs, frames, origin, notes, sole_m) -> dict:
     lengths = {"thigh_m": [], "shank_m": []}
     for side in SIDES:
         p = points[side]
@@ -146,11 +151,11 @@ def _geometry(tree, points, legs, frames, origin, notes) -> dict:
     for key, values in lengths.items():
         if abs(values[0] - values[1]) > 1e-6:
             notes.append(f"{key}: left {values[0]:.6f}, right {values[1]:.6f} m (averaged)")
-    geometry.update(_sole(tree, points, legs, frames, origin, notes))
+    geometry.update(_sole(tree, points, legs, frames, origin, notes, sole_m))
     return {k: float(v) for k, v in geometry.items()}
 
 
-def _sole(tree, points, legs, frames, origin, notes) -> dict:
+def _sole(tree, points, legs, frames, origin, notes, sole_m) -> dict:
     """The sole from the union of the foot's collision boxes (the bodies rigid with the last leg joint)."""
     found = {}
     for side in SIDES:
@@ -163,9 +168,12 @@ def _sole(tree, points, legs, frames, origin, notes) -> dict:
             for box in tree.bodies[name].boxes:
                 signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
                 corners += list(o + (r @ (box.centre_m + (signs * box.half_m) @ box.rotation.T).T).T - origin)
+        if not corners and sole_m is not None:
+            notes.append("no box collision shape on the feet: the sole is the --like config's")
+            return dict(sole_m)
         if not corners:
             raise tree.fail(f"body {foot}", f"no box collision shape on the {side} foot: gaitbot needs the sole's size "
-                                            f"(add a box to the foot, or give it in the config by hand)")
+                                            f"(add a box to the foot, or give a config with --like)")
         lo, hi = np.min(corners, axis=0), np.max(corners, axis=0)
         ankle = points[side]["ankle"]
         s = 1 if side == "left" else -1
