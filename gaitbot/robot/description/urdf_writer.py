@@ -50,7 +50,9 @@ def _inertial(link) -> str:
 
 def _shape(kind: str, size: str, xyz, colour: str, collision: bool = False) -> str:
     geometry = f'<geometry><{kind} {size}/></geometry>'
-    text = f'<visual>{_origin(xyz)}{geometry}<material name=""><color rgba="{colour}"/></material></visual>'
+    name = next(key for key, rgba in COLOURS.items() if rgba == colour)
+    material = f'<material name="gaitbot_{name}"><color rgba="{colour}"/></material>'
+    text = f'<visual>{_origin(xyz)}{geometry}{material}</visual>'
     return text + (f'<collision>{_origin(xyz)}{geometry}</collision>' if collision else "")
 
 
