@@ -15,6 +15,10 @@ Mapping: Menagerie's joint angles are ROBOTIS's (same axes and zero pose), so ou
 with the directions of config/op3.toml (its ROBOTIS-to-ours signs). The arms and head are held at
 ROBOTIS's initial pose (op3_base_module/data/ini_pose.yaml), as config/op3.toml's torso assumes.
 Used by tools/robustness.py (and so by tests/sim/test_sim_balance.py's quick robustness run).
+
+    python tools/op3_menagerie.py > op3.xml           # the stripped model (docs/robot-description.md imports it)
+    python tools/op3_menagerie.py --play walk.npz     # a trajectory played open loop on it (exit 1: a fall,
+                                                      # or travelled more than PLAN_SHARE off the plan)
 """
 
 from __future__ import annotations
@@ -89,6 +93,7 @@ JOINT_MAP = {  # our leg joint -> (Menagerie's joint suffix, ours = sign x their
 ARM_HOLD_RAD = {"head_pan": 0.0, "head_tilt": -0.17453, "l_sho_pitch": -0.2618, "r_sho_pitch": 0.2618,
                 "l_sho_roll": 0.7854, "r_sho_roll": -0.7854, "l_el": -0.7854, "r_el": 0.7854}
 FALL_TILT_DEG = 45.0
+PLAN_SHARE = 0.15  # --play's pass: within 15% of the planned distance (issue 24)
 PUSH_DURATION_S = 0.1
 SETTLE_AFTER_S = 1.0
 
@@ -218,3 +223,27 @@ def play(trajectory, rate_hz: float, friction: float = 1.0, push_n_s: float = 0.
     result.torso_roll_rms_deg = float(np.sqrt(np.mean(rpy[:, 0] ** 2)))
     result.torso_pitch_rms_deg = float(np.sqrt(np.mean(rpy[:, 1] ** 2)))
     return result
+
+
+def main(argv=None) -> int:
+    import argparse
+    import sys
+
+    parser = argparse.ArgumentParser(description="MuJoCo Menagerie's OP3 without meshes: print it, or play a walk")
+    parser.add_argument("--play", metavar="TRAJECTORY", help="a trajectory (gaitbot generate) to play open loop")
+    args = parser.parse_args(argv)
+    if args.play is None:
+        sys.stdout.write(menagerie_mjcf())
+        return 0
+    from gaitbot.gait.trajectory import Trajectory
+
+    trajectory = Trajectory.load(args.play)
+    r = play(trajectory, 1.0 / float(np.median(np.diff(trajectory.t_s))))
+    print(f"{'fell ' + r.fall_direction + f' at {r.fell_at_s} s' if r.fell else 'did not fall'}; travelled "
+          f"{r.distance_travelled_m:.3f} m of {r.distance_planned_m:.3f} m planned "
+          f"({100 * r.distance_travelled_m / r.distance_planned_m:.1f}%), lateral drift {100 * r.lateral_drift_m:+.1f} cm")
+    return 1 if r.fell or abs(r.distance_travelled_m / r.distance_planned_m - 1) > PLAN_SHARE else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -31,13 +31,14 @@ import warnings  # noqa: E402
 
 from gaitbot import __version__  # noqa: E402
 from gaitbot.app.help import COMMAND_HELP, DESCRIPTION, EPILOG, HelpFormatter  # noqa: E402
+from gaitbot.app.robot import add_parser as add_robot_parser  # noqa: E402
 from gaitbot.errors import UserError  # noqa: E402
 from gaitbot.stream.signals import StopSignals, Terminated  # noqa: E402 - light: rooms come with the commands
 
 #: Subcommand -> the module of gaitbot.app whose ``run(args)`` does it (imported when used: ``plot``
 #: needs matplotlib, ``walk --sim`` MuJoCo, and the rest should not wait for them).
 COMMANDS = {name: f"gaitbot.app.{name}" for name in ("plan", "generate", "plot", "walk", "check", "eigen", "record",
-                                                     "scan", "setup", "calibrate")}
+                                                     "scan", "setup", "calibrate", "robot")}
 
 #: What ``walk --dry-run`` and ``walk --sim`` walk when no steps are given: the demo (said on stderr).
 DEMO_DISTANCE_M = 0.5
@@ -236,6 +237,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--port", help="serial port (default: the robot config's)")
     p.add_argument("--yes", action="store_true", help="turn torque off without asking")
     p.add_argument("--reply-timeout-ms", type=float, metavar="MS", help=REPLY_TIMEOUT_HELP)
+    parser.commands.update(add_robot_parser(sub, _command))
     return parser
 
 

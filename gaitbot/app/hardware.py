@@ -50,6 +50,9 @@ def refuse_port_in_dry_run(args) -> None:
 def serial_port(config: RobotConfig, port: str | None, dry_run: bool) -> str:
     """``--port``, else the config's; outside a dry run it must exist."""
     port = port or config.bus.port
+    if not dry_run and config.draft is not None:
+        raise UsageError(f"{config.path}: robot.draft: a draft config ({config.draft}); the hardware needs a "
+                         f"checked one (docs/robot-description.md)")
     if not dry_run:
         require_port(port)
     return port

@@ -153,4 +153,28 @@ COMMAND_HELP = {
         ("gaitbot calibrate --help",),
         ("gaitbot calibrate --robot robots/mybot.toml -o robots/mybot.calibration.toml",
          "gaitbot walk --robot robots/mybot.toml --calibration robots/mybot.calibration.toml --distance 0.5")),
+    "robot": CommandHelp(
+        "a robot config to and from URDF and MJCF (the field's robot descriptions)",
+        "Export a robot config as URDF or MJCF for the tools the field looks at robots with (RViz, Foxglove,\n"
+        "MuJoCo's viewer, PlaCo), or import a robot's URDF or MJCF as a config draft (docs/robot-description.md).",
+        ("gaitbot robot export op3 --urdf op3.urdf --mjcf op3.xml",
+         "gaitbot robot import op3.urdf --like config/op3.toml -o mine.toml")),
+    "robot export": CommandHelp(
+        "write a robot config as URDF and/or MJCF",
+        "Links, joints (axes, the config's limits), masses, centres of mass and inertias, the feet as boxes,\n"
+        "held joints fixed at their hold angles. The MJCF is the simulated robot itself (gaitbot walk --sim's\n"
+        "model); frame names in docs/robot-description.md.",
+        ("gaitbot robot export op3 --urdf op3.urdf",
+         "gaitbot robot export ax12a-biped --urdf ax12a.urdf --mjcf ax12a.xml")),
+    "robot import": CommandHelp(
+        "read a URDF or MJCF as a robot config draft",
+        "Find the legs' joints (by name, or --map), check their axes and signs by forward kinematics, measure\n"
+        "the legs and sum every link's mass, centre of mass and inertia into gaitbot's links; the bus, servos,\n"
+        "ids and gait come from --like CONFIG, or are placeholders and the draft says so ([robot] draft: the\n"
+        "hardware commands refuse it until it is checked). Prints the joint mapping to confirm. A leg that is\n"
+        "not 6 (or 3 pitch) hinges in a chain is refused (exit 2).",
+        ("gaitbot robot export op3 --urdf op3.urdf",
+         "gaitbot robot import op3.urdf --like config/op3.toml -o mine.toml",
+         "gaitbot robot import op3.urdf -o draft.toml",
+         "gaitbot plan --robot mine.toml --distance 0.3")),
 }

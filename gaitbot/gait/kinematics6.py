@@ -51,6 +51,14 @@ def rot_z(a) -> np.ndarray:
     return _rotation(a, 0, 1)
 
 
+def joint_axis(kind: str, side: str) -> tuple[float, float, float]:
+    """A leg joint's axis in the root frame at the zero pose (positive angle = the convention's sense):
+    the rotations of the chain above, written as axes (the simulated and the exported models use them)."""
+    s = SIDE_SIGN[side]
+    return {"hip_yaw": (0, 0, s), "hip_roll": (s, 0, 0), "hip_pitch": (0, -1, 0), "knee_pitch": (0, 1, 0),
+            "ankle_pitch": (0, -1, 0), "ankle_roll": (s, 0, 0)}[kind]
+
+
 def leg_frames(geometry: BodyGeometry, side: str, q_rad) -> tuple[np.ndarray, np.ndarray]:
     """Every leg link's frame in the root frame, for joint angles q_rad (..., 6).
 

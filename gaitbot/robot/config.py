@@ -183,6 +183,7 @@ class RobotConfig:
     balance: BalanceSettings = BalanceSettings()
     links: tuple[tuple[str, LinkInertial], ...] | None = None
     boom: bool = False
+    draft: str | None = None  # [robot] draft: a config imported with placeholders (hardware refuses it)
 
     @cached_property
     def body(self) -> BodyModel:
@@ -343,7 +344,7 @@ _LINK_NAMES = ("torso",) + LEG_LINKS
 _LINK_KEYS = ("mass_kg", "com_m", "inertia_kg_m2")
 _SERVO_KEYS = ("stall_torque_nm", "no_load_speed_rpm", "full_torque_error_deg")
 _TERRAIN_KEYS = ("max_rise_m", "max_drop_m", "max_gap_m")
-_ROBOT_KEYS = ("name", "boom")
+_ROBOT_KEYS = ("name", "boom", "draft")
 _GEOMETRY_KEYS = ("thigh_m", "shank_m", "foot_m", "hip_width_m", "ankle_height_m", "heel_back_m", "foot_width_m",
                   "sole_outward_m", "hip_below_root_m")
 _GAIT_KEYS = ("cycle_s", "max_step_m", "clearance_m", "rate_hz")
@@ -369,6 +370,7 @@ class _Reader(Fields):
         bus = self.bus(self.table(data, "bus", "bus", _BUS_KEYS))
         joints = self.joints(data, bus)
         boom = self.boolean(robot, "boom", "robot", default=False)
+        draft = self.string(robot, "draft", "robot") if "draft" in robot else None
         links = self.links(data) if "links" in data else None
         mass = self.mass(self.optional_table(data, "mass", "mass", _MASS_KEYS), links)
         servo = self.servo(self.optional_table(data, "servo", "servo", _SERVO_KEYS))
@@ -383,7 +385,7 @@ class _Reader(Fields):
         balance = self.balance(self.optional_table(data, "balance", "balance", BalanceSettings.field_names()))
         config = RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
                              mass=mass, servo=servo, terrain=terrain, health=health, balance=balance, links=links,
-                             boom=boom)
+                             boom=boom, draft=draft)
         self.three_d_checks(config)
         return config
 

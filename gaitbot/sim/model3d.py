@@ -21,21 +21,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from gaitbot.gait.body import LEG_LINKS, SIDE_SIGN
+from gaitbot.gait.body import LEG_LINKS
 from gaitbot.gait.joints import LEG_JOINT_KINDS, SIDES
+from gaitbot.gait.kinematics6 import joint_axis
 from gaitbot.robot.config import RobotConfig
-from gaitbot.sim.model import LEG_RGBA, SOLE_THICKNESS_M, JointDrive, mjcf_document, substeps_per_frame
+from gaitbot.sim.model import LEG_RGBA, SOLE_THICKNESS_M, JointDrive, joint_drives, mjcf_document, substeps_per_frame
 
 SUPPORTS = ("free", "boom", "boom-pitch")
 MIN_MOVING_LINK_KG = 1e-4  # MuJoCo needs mass on a body that moves; a massless link of a pitch-only leg gets this
 MIN_MOVING_LINK_INERTIA_KG_M2 = 1e-9
-
-
-def joint_axis(kind: str, side: str) -> tuple[float, float, float]:
-    """A joint's axis in the root frame at the zero pose (positive angle = the convention's sense)."""
-    s = SIDE_SIGN[side]
-    return {"hip_yaw": (0, 0, s), "hip_roll": (s, 0, 0), "hip_pitch": (0, -1, 0), "knee_pitch": (0, 1, 0),
-            "ankle_pitch": (0, -1, 0), "ankle_roll": (s, 0, 0)}[kind]
 
 
 def _f(*values) -> str:
@@ -53,11 +47,21 @@ def _inertial(link, moving: bool) -> str:
             f'fullinertia="{_f(i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2])}"/>')
 
 
+def _held_turn(config: RobotConfig, name: str, drive) -> str:
+    """A held joint that is not modelled (the exported model: held joints fixed) is welded at its hold angle."""
+    held = {j.name: j.hold_deg for j in config.held_joints}
+    if drive is not None or not held.get(name):
+        return ""
+    half = np.radians(held[name]) / 2
+    axis = np.array(joint_axis(*name.rsplit("_", 1)))
+    return f' quat="{_f(np.cos(half), *(np.sin(half) * axis))}"'
+
+
 def capsule_radius_m(config: RobotConfig) -> float:
     return 0.055 * config.body.geometry.leg_length_m
 
 
-def _leg(config: RobotConfig, side: str, drives: dict[str, JointDrive]) -> str:
+def _leg(config: RobotConfig, side: str, drives: dict[str, JointDrive], exact: bool = False) -> str:
     g = config.body.geometry
     radius = capsule_radius_m(config)
     colour = LEG_RGBA[side]
@@ -81,22 +85,28 @@ def _leg(config: RobotConfig, side: str, drives: dict[str, JointDrive]) -> str:
     offsets = {"hip_yaw": g.hip_in_root(side), "hip_roll": (0, 0, 0), "thigh": (0, 0, 0), "shank": (0, 0, -g.thigh_m),
                "ankle": (0, 0, -g.shank_m), "foot": (0, 0, 0)}
     text, closing = "", ""
-    for kind, link in zip(LEG_JOINT_KINDS, LEG_LINKS):
+    masses = [config.body.leg_links[link].mass_kg for link in LEG_LINKS]
+    for k, (kind, link) in enumerate(zip(LEG_JOINT_KINDS, LEG_LINKS)):
         name = f"{kind}_{side}"
         drive = drives.get(name)
         joint = ""
         if drive is not None:
             joint = (f'<joint name="{name}" axis="{_f(*joint_axis(kind, side))}" range="{_f(drive.min_deg, drive.max_deg)}" '
                      f'damping="{_f(drive.damping_nm_s_per_rad)}" armature="{_f(drive.armature_kg_m2)}"/>')
-        text += (f'<body name="{link}_{side}" pos="{_f(*offsets[link])}">{joint}'
-                 f'{_inertial(config.body.leg_link(link, side), drive is not None)}{shapes.get(link, "")}')
+        # exact (the exported model): a massless link that carries massy ones stays massless (MuJoCo allows it)
+        moving = drive is not None and not (exact and sum(masses[k + 1:]) > 0)
+        text += (f'<body name="{link}_{side}" pos="{_f(*offsets[link])}"{_held_turn(config, name, drive)}>{joint}'
+                 f'{_inertial(config.body.leg_link(link, side), moving)}{shapes.get(link, "")}')
         closing += "</body>"
     return text + closing
 
 
-def build_mjcf_3d(config: RobotConfig, drives: tuple[JointDrive, ...], rate_hz: float, support: str = "free") -> str:
+def build_mjcf_3d(config: RobotConfig, drives: tuple[JointDrive, ...], rate_hz: float, support: str = "free",
+                  exact_masses: bool = False) -> str:
     """The MJCF document of the robot standing straight with its soles on the floor at z = 0 (the root at
-    the standing height); ``drives``: the modelled joints' servos, in the order of the actuators."""
+    the standing height); ``drives``: the modelled joints' servos, in the order of the actuators.
+    ``exact_masses``: no minimum mass on a moving massless link that carries others (the exported model's
+    masses are the config's exactly; the simulation keeps the minimum, as it always had)."""
     if support not in SUPPORTS:
         raise ValueError(f"support must be one of {SUPPORTS}, got {support!r}")
     g = config.body.geometry
@@ -110,7 +120,7 @@ def build_mjcf_3d(config: RobotConfig, drives: tuple[JointDrive, ...], rate_hz: 
     else:
         root_joints = ('<joint name="boom_x" type="slide" axis="1 0 0"/><joint name="boom_z" type="slide" axis="0 0 1"/>'
                        + ('<joint name="boom_pitch" type="hinge" axis="0 1 0"/>' if support == "boom-pitch" else ""))
-    legs = "".join(_leg(config, side, by_name) for side in SIDES)
+    legs = "".join(_leg(config, side, by_name, exact_masses) for side in SIDES)
     torso = f"""<body name="torso" pos="0 0 {_f(g.standing_root_height_m)}">
       {root_joints}
       {_inertial(config.body.torso, True)}
@@ -118,3 +128,10 @@ def build_mjcf_3d(config: RobotConfig, drives: tuple[JointDrive, ...], rate_hz: 
       {legs}
     </body>"""
     return mjcf_document(config.name, timestep, drives, torso, number=_f)
+
+
+def exported_mjcf(config: RobotConfig) -> str:
+    """``gaitbot robot export --mjcf``: the simulated robot itself (this module's model, free-floating, at the
+    config's frame rate), its walking joints driven by their servos and its held joints fixed at their hold
+    angles. Body and joint names are gaitbot's (docs/robot-description.md)."""
+    return build_mjcf_3d(config, joint_drives(config), config.gait.rate_hz, "free", exact_masses=True)

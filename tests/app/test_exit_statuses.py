@@ -40,6 +40,7 @@ def files(tmp_path_factory):
         examples.append(str(path))
     model = folder / "model.npz"
     assert main(["eigen", "fit", *examples, "-o", str(model)]) == 0
+    assert main(["robot", "export", "op3", "--urdf", str(folder / "op3.urdf")]) == 0
     tight = folder / "tight.toml"
     tight.write_text((CONFIG_DIR / "xl430-biped.toml").read_text().replace("max_deg = 110.0", "max_deg = 20.0"))
     return {"walk": walk, "broken": broken, "examples": examples, "model": model, "tight": tight, "out": folder}
@@ -77,6 +78,12 @@ CASES = [
     ("scan", "scan --dry-run --robot none-such", 2),
     ("setup", "setup --joint elbow_left --port /dev/null", 2),  # no such joint: refused before the port is opened
     ("calibrate", "calibrate -o {out}/cal.json --port /dev/null", 2),  # a calibration file is TOML
+    ("robot", "robot export ax12a-biped --urdf {out}/ax12a.urdf", 0),
+    ("robot", "robot export none-such --urdf {out}/x.urdf", 2),  # no such robot
+    ("robot export", "robot export op3 --mjcf {out}/op3.xml", 0),
+    ("robot export", "robot export op3", 2),  # no output named
+    ("robot import", "robot import {out}/op3.urdf --like op3 -o {out}/mine.toml", 0),
+    ("robot import", "robot import {walk} -o {out}/mine.toml", 2),  # a CSV is not a robot description
 ]
 
 
