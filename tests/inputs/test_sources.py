@@ -13,7 +13,8 @@ from gaitbot.errors import UserError
 from gaitbot.gait.steer.command import STILL, TimedCommand, VelocityCommand
 from gaitbot.inputs.keyboard import KeyboardSource, split_keys
 from gaitbot.inputs.scripted import ScriptedSource
-from gaitbot.inputs.source import WATCHDOG_S, open_source
+from gaitbot.inputs.open import open_source
+from gaitbot.inputs.source import WATCHDOG_S
 from gaitbot.inputs.udp import UdpSource
 
 MAX = VelocityCommand(0.2, 0.1, 40.0)
