@@ -7,14 +7,40 @@ Neither library is needed unless asked for: without ``gaitbot[view]`` installed 
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
+DEFAULT_FOXGLOVE = "127.0.0.1:8765"  # gaitbot.view.live's default: loopback only
+
+
+def host_port(text: str) -> tuple[str, int]:
+    """``--foxglove [HOST:]PORT`` or ``HOST`` (port 8765); PORT 0 picks a free port."""
+    host, colon, port_text = text.rpartition(":")
+    if not colon:
+        host, port_text = ("", text) if text.isdigit() else (text, "8765")
+    port = int(port_text) if port_text.isdigit() else -1
+    if not 0 <= port <= 65535 or host.startswith("["):
+        raise argparse.ArgumentTypeError(f"expected [HOST:]PORT with PORT 0..65535 (default {DEFAULT_FOXGLOVE}), "
+                                         f"got {text!r}")
+    return host or "127.0.0.1", port
+
+
+def mcap_path(text: str) -> str:
+    """``--mcap FILE``: a file that can be written, checked before any work is done."""
+    from gaitbot.app.options import UsageError, check_output_path, file_option
+
+    try:
+        check_output_path(Path(file_option(text, "--mcap")), "--mcap")
+    except UsageError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("--mcap ")) from None
+    return text
+
 
 def add_view_options(p) -> None:
-    p.add_argument("--mcap", metavar="FILE", help="write the walk's telemetry (joints, transforms, CoM, ZMP, feet, "
+    p.add_argument("--mcap", metavar="FILE", type=mcap_path, help="write the walk's telemetry (joints, transforms, CoM, ZMP, feet, "
                    "servo health) to this MCAP file (ROS 2 messages: Foxglove and ros2 bag open it)")
-    p.add_argument("--foxglove", nargs="?", const="127.0.0.1:8765", metavar="HOST:PORT",
+    p.add_argument("--foxglove", nargs="?", const=host_port(DEFAULT_FOXGLOVE), type=host_port, metavar="HOST:PORT",
                    help="serve the same telemetry live to Foxglove (default 127.0.0.1:8765; another HOST is reachable "
                    "from the network) and take its Teleop panel's Twists on /cmd_vel (drive)")
 
@@ -47,17 +73,15 @@ class WalkView:
             print(f"note: {note}", file=sys.stderr)
 
 
-def open_view(args, config, goals, planned=None, health=None) -> WalkView | None:
-    """The view of ``args.mcap`` / ``args.foxglove`` for this walk, or None when neither was asked for."""
+def open_view(args, config, goals, planned=None, health=None, realtime: bool = True) -> WalkView | None:
+    """The view of ``args.mcap`` / ``args.foxglove`` for this walk, or None when neither was asked for;
+    ``realtime``: the walk runs on a real clock (a full telemetry queue then drops a frame, never waits)."""
     mcap, foxglove = getattr(args, "mcap", None), getattr(args, "foxglove", None)
     if mcap is None and foxglove is None:
         return None
-    from gaitbot.app.options import UsageError, check_output_path, file_option
-
-    if mcap is not None:
-        check_output_path(Path(file_option(mcap, "--mcap")), "--mcap")
-    from gaitbot.view.live import ViewOptionError, parse_host_port
-    from gaitbot.view.publisher import TelemetryPublisher
+    from gaitbot.app.options import UsageError
+    from gaitbot.view.live import ViewOptionError
+    from gaitbot.view.publisher import BackgroundPublisher, TelemetryPublisher
     from gaitbot.view.walk_frames import PlannedFrames
 
     sinks, teleop = [], None
@@ -68,11 +92,11 @@ def open_view(args, config, goals, planned=None, health=None) -> WalkView | None
         if foxglove is not None:
             from gaitbot.view.live import FoxgloveSink
             from gaitbot.view.teleop import TeleopSource
-            live = FoxgloveSink(*parse_host_port(foxglove))
+            live = FoxgloveSink(*foxglove)
             print(f"foxglove: ws://{live.host}:{live.port} (open it in Foxglove: docs/live-view.md)", file=sys.stderr)
             sinks.append(live)
             teleop = TeleopSource(live.inbox)
-        publisher = TelemetryPublisher(config.body.geometry, sinks)
+        publisher = BackgroundPublisher(TelemetryPublisher(config.body.geometry, sinks), lossless=not realtime)
     except (ImportError, OSError, ViewOptionError) as exc:
         for sink in sinks:
             sink.close()

@@ -116,7 +116,7 @@ def run(args) -> int:
     what = "simulating" if sim is not None else "walking"
     view = None
     try:
-        view = open_view(args, config, trajectory, planned, health)  # --mcap, --foxglove (None without them)
+        view = open_view(args, config, trajectory, planned, health, not isinstance(clock, VirtualClock))
         with progress(what, total=len(frames), unit="frame") as bar:
             status = _status(bar, walker.heel_strikes, source.settings.rate_hz, health)
             result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,

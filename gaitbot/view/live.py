@@ -16,29 +16,12 @@ from gaitbot.view.ros2_messages import schema_text
 from gaitbot.view.telemetry import NEEDS_VIEW_EXTRA
 from gaitbot.view.teleop import TeleopInbox
 
-DEFAULT_HOST, DEFAULT_PORT = "127.0.0.1", 8765
+DEFAULT_HOST, DEFAULT_PORT = "127.0.0.1", 8765  # the SDK's own default port
 LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
 
 
 class ViewOptionError(UserError, ValueError):
     """A --foxglove or --mcap argument that cannot be used."""
-
-
-def parse_host_port(text: str | None) -> tuple[str, int]:
-    """``[HOST:]PORT``, ``HOST`` or nothing (127.0.0.1:8765); PORT 0 picks a free port."""
-    if not text:
-        return DEFAULT_HOST, DEFAULT_PORT
-    host, colon, port_text = text.rpartition(":")
-    if not colon:
-        host, port_text = (text, str(DEFAULT_PORT)) if not text.isdigit() else ("", text)
-    try:
-        port = int(port_text)
-    except ValueError:
-        port = -1
-    if not 0 <= port <= 65535 or host.startswith("["):
-        raise ViewOptionError(f"--foxglove {text}: expected [HOST:]PORT with PORT 0..65535 (default "
-                              f"{DEFAULT_HOST}:{DEFAULT_PORT})")
-    return host or DEFAULT_HOST, port
 
 
 def import_foxglove():

@@ -1,12 +1,18 @@
-"""The observer that turns each frame into ROS 2 messages once and hands the bytes to its sinks.
+"""The observer that turns each frame into ROS 2 messages once and hands the bytes to its sinks, and the
+thread that does it away from the walk's loop.
 
-A sink is an MCAP file (gaitbot.view.mcap_log) or a live Foxglove server (gaitbot.view.live): anything
+:class:`BackgroundPublisher` is what a session gets: ``on_frame`` only queues the record (tens of
+microseconds, tools/bench_view.py); a worker thread encodes and writes. On a real-time walk a full queue
+drops the frame (counted, said at the end) rather than wait; on a simulated clock, which runs as fast as
+the CPU allows, the walk waits for the log instead, so the log holds every frame. A sink is an MCAP file (gaitbot.view.mcap_log) or a live Foxglove server (gaitbot.view.live): anything
 with ``write(topic, type_name, data, log_time_ns)`` and ``close()``. A sink that fails (a full disk, a
 closed server) is dropped with a note and the walk goes on: telemetry never stops the robot.
 """
 
 from __future__ import annotations
 
+import queue
+import threading
 import time
 
 from gaitbot.gait.body import BodyGeometry
@@ -64,3 +70,62 @@ def _close_quietly(sink) -> None:
         sink.close()
     except Exception:  # noqa: BLE001 - already reported by the caller
         pass
+
+
+QUEUED_FRAMES = 120  # 2 s at 60 Hz: a stalled disk or a slow moment of the CPU, absorbed
+CLOSE_WAIT_S = 10.0  # the most the end of a walk waits for the log to be written
+
+
+class BackgroundPublisher:
+    """A TelemetryPublisher on its own thread (the module docstring says when a frame may be dropped)."""
+
+    def __init__(self, publisher: TelemetryPublisher, lossless: bool = False) -> None:
+        self.publisher = publisher
+        self.lossless = lossless
+        self.dropped = 0
+        self._queue: queue.Queue = queue.Queue(maxsize=QUEUED_FRAMES)
+        self._thread = threading.Thread(target=self._work, name="gaitbot-view", daemon=True)
+        self._thread.start()
+        self._closed = False
+
+    def _work(self) -> None:
+        while True:
+            frame = self._queue.get()
+            if frame is None:
+                return
+            try:
+                self.publisher.on_frame(frame)
+            except Exception as exc:  # noqa: BLE001 - a frame that cannot be encoded: said, the walk goes on
+                if len(self.publisher.notes) < 10:
+                    self.publisher.notes.append(f"telemetry: a frame at {frame.t_s:.2f} s was not written: {exc}")
+
+    def on_frame(self, frame: FrameTelemetry) -> None:
+        if self._closed:
+            return
+        if self.lossless:
+            self._queue.put(frame)
+            return
+        try:
+            self._queue.put_nowait(frame)
+        except queue.Full:
+            self.dropped += 1
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            self._queue.put(None, timeout=CLOSE_WAIT_S)
+        except queue.Full:
+            pass
+        self._thread.join(CLOSE_WAIT_S)
+        if self._thread.is_alive():
+            self.publisher.notes.append(f"telemetry: not all written within {CLOSE_WAIT_S:g} s")
+        else:
+            self.publisher.close()
+        if self.dropped:
+            self.publisher.notes.append(f"telemetry: {self.dropped} frames dropped (the log or viewer fell behind)")
+
+    @property
+    def notes(self) -> list[str]:
+        return self.publisher.notes

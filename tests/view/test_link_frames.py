@@ -70,3 +70,16 @@ def test_rotation_quaternion_round_trip():
         q = rotation_xyzw(rotation)
         assert np.isclose(np.linalg.norm(q), 1.0)
         assert np.allclose(quaternion_matrix(q), rotation, atol=1e-12)
+
+
+def test_sole_poses_from_corners_are_the_foot_pose():
+    """The footprints' poses (from the sole corners) against the foot link's rotation and the sole centre."""
+    from gaitbot.gait.kinematics6 import foot_pose, sole_corners
+    from gaitbot.view.walk_frames import sole_poses
+
+    geometry = config("op3").body.geometry
+    q = np.random.default_rng(3).uniform(-0.5, 0.5, (40, 6))
+    for side in SIDES:
+        centre, rotation = sole_poses(sole_corners(geometry, side, q))
+        assert np.allclose(centre, sole_centre(geometry, side, q), atol=1e-12)
+        assert np.allclose(rotation, foot_pose(geometry, side, q)[1], atol=1e-12)

@@ -2,6 +2,7 @@
 written here from the spec) subscribes to the joint and transform channels and decodes them, and publishes a
 Twist that the teleop source turns into a command. Loopback only, every wait bounded."""
 
+import argparse
 import asyncio
 import json
 import struct
@@ -13,7 +14,8 @@ pytest.importorskip("foxglove")
 websockets = pytest.importorskip("websockets")
 
 from gaitbot.gait.joints import LEG_JOINTS  # noqa: E402
-from gaitbot.view.live import FoxgloveSink, ViewOptionError, parse_host_port  # noqa: E402
+from gaitbot.app.view_options import host_port  # noqa: E402
+from gaitbot.view.live import FoxgloveSink  # noqa: E402
 from gaitbot.view.publisher import TelemetryPublisher  # noqa: E402
 from gaitbot.view.ros2_messages import decoder  # noqa: E402
 from gaitbot.view.telemetry import FrameTelemetry  # noqa: E402
@@ -101,14 +103,14 @@ def test_a_foxglove_client_sees_joints_and_transforms_and_steers():
     assert got["silent"].command.is_still and any("no Twist" in m for m in got["silent"].messages)
 
 
-def test_host_port_parsing_and_binding_warning(capsys):
-    assert parse_host_port(None) == ("127.0.0.1", 8765)
-    assert parse_host_port("0.0.0.0:9000") == ("0.0.0.0", 9000)
-    assert parse_host_port("9001") == ("127.0.0.1", 9001)
-    assert parse_host_port("localhost") == ("localhost", 8765)
-    for bad in ("host:99999", "host:x", "[::1]:80"):
-        with pytest.raises(ViewOptionError, match="--foxglove"):
-            parse_host_port(bad)
+def test_host_port_parsing_and_binding_warning():
+    assert host_port("127.0.0.1:8765") == ("127.0.0.1", 8765)
+    assert host_port("0.0.0.0:9000") == ("0.0.0.0", 9000)
+    assert host_port("9001") == ("127.0.0.1", 9001)
+    assert host_port("localhost") == ("localhost", 8765)
+    for bad in ("host:99999", "host:x", "[::1]:80", "host:", ":"):
+        with pytest.raises(argparse.ArgumentTypeError, match="HOST:.PORT"):
+            host_port(bad)
     lines = []
     sink = FoxgloveSink("0.0.0.0", 0, warn=lines.append)
     sink.close()
