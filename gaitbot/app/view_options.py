@@ -33,7 +33,7 @@ def mcap_path(text: str) -> str:
     try:
         check_output_path(Path(file_option(text, "--mcap")), "--mcap")
     except UsageError as exc:
-        raise argparse.ArgumentTypeError(str(exc).removeprefix("--mcap ")) from None
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("--mcap: ").removeprefix("--mcap ")) from None
     return text
 
 
