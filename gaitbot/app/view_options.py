@@ -34,6 +34,8 @@ def mcap_path(text: str) -> str:
         check_output_path(Path(file_option(text, "--mcap")), "--mcap")
     except UsageError as exc:
         raise argparse.ArgumentTypeError(str(exc).removeprefix("--mcap: ").removeprefix("--mcap ")) from None
+    except OSError as exc:  # a name the OS refuses (too long, a loop)
+        raise argparse.ArgumentTypeError(f"cannot write there ({exc.strerror or exc})") from None
     return text
 
 

@@ -40,7 +40,8 @@ def test_a_full_disk_stops_the_log_not_the_walk(capsys):
 @pytest.mark.parametrize("argv, says", [
     (("--mcap", "/no/such/dir/w.mcap"), "argument --mcap: /no/such/dir/w.mcap: cannot write there"),
     (("--foxglove", "host:70000"), "argument --foxglove: expected [HOST:]PORT"),
-    (("--mcap", ""), "argument --mcap: empty file name")])
+    (("--mcap", ""), "argument --mcap: empty file name"),
+    (("--mcap", "x" * 5000), "argument --mcap: cannot write there (File name too long)")])
 def test_bad_options_are_refused_before_anything(argv, says, capsys):
     with pytest.raises(SystemExit) as exit_:  # argparse: the usage error, before the robot is even loaded
         run_cli(capsys, "walk", "--robot", "op3", "--dry-run", "--distance", "0.1", *argv)
