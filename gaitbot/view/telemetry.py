@@ -9,7 +9,6 @@ lengths metres, times seconds on the walk's clock from its start; positions are 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -78,26 +77,6 @@ class Telemetry(Protocol):
 
     def close(self) -> None:
         """Finish (write an MCAP's summary, stop a server); idempotent."""
-
-
-class Observers:
-    """Several observers behind one ``on_frame``: the session calls one object whatever was asked for."""
-
-    def __init__(self, observers: Sequence[Telemetry]) -> None:
-        self.observers = list(observers)
-
-    def on_frame(self, frame: FrameTelemetry) -> None:
-        for observer in self.observers:
-            observer.on_frame(frame)
-
-    def close(self) -> None:
-        for observer in self.observers:
-            observer.close()
-
-    @property
-    def notes(self) -> list[str]:
-        """What the observers have to tell the user at the end (a log that stopped, where it was written)."""
-        return [note for observer in self.observers for note in getattr(observer, "notes", [])]
 
 
 def health_of(monitor) -> ServoHealth | None:
