@@ -1,15 +1,16 @@
-"""The robot's link frames from its joint angles, as a URDF of it names and places them (for /tf).
+"""The robot's link frames from its joint angles, as the URDF export of it names and places them (for /tf).
 
-Naming convention (docs/live-view.md; the URDF export uses the same names): the pelvis is ``base_link``;
-the link a joint turns is ``<joint name>_link`` (``hip_pitch_left_link`` is the thigh,
-``ankle_roll_left_link`` the foot); each joint's parent is the link of the joint above it in its leg
-(``hip_yaw_<side>``'s parent is ``base_link``). The world frame is ``world`` (floor at z = 0).
+Naming (docs/live-view.md; the same as ``gaitbot robot export --urdf`` and the simulated robot's bodies):
+the pelvis is ``base_link``; per leg, from the pelvis down, the links ``hip_yaw_<side>``, ``hip_roll_<side>``,
+``thigh_<side>``, ``shank_<side>``, ``ankle_<side>`` and ``foot_<side>`` (gaitbot.gait.body.LEG_LINKS), each
+turned by the joint of the same rank (``hip_yaw_left`` ... ``ankle_roll_left``); the fixed frame is ``odom``
+(REP-105: the walk's world frame as dead reckoning knows it, the floor at z = 0).
 
-Each joint frame sits at its joint point with the root's axes at the zero pose, as gaitbot.gait.kinematics6
-defines the leg: hip_yaw at the hip point, hip_roll and hip_pitch on it, knee_pitch ``thigh_m`` below,
-ankle_pitch ``shank_m`` below that, ankle_roll on it; axes in gaitbot's sign conventions
-(gaitbot.gait.joints). A joint's transform is then its fixed offset and a rotation about its axis by its
-angle, which is what a URDF's revolute joint with ``rpy="0 0 0"`` and that axis gives.
+Each link frame sits at its joint point with the root's axes at the zero pose, as gaitbot.gait.kinematics6
+defines the leg: hip_yaw at the hip point, hip_roll and thigh on it, shank ``thigh_m`` below, ankle
+``shank_m`` below that, foot on it; axes in gaitbot's sign conventions (gaitbot.gait.joints). A joint's
+transform is then its fixed offset and a rotation about its axis by its angle, which is what a URDF's
+revolute joint with ``rpy="0 0 0"`` and that axis gives.
 """
 
 from __future__ import annotations
@@ -19,16 +20,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gaitbot.gait.body import SIDE_SIGN, BodyGeometry
+from gaitbot.gait.body import LEG_LINKS, SIDE_SIGN, BodyGeometry
 from gaitbot.gait.joints import LEG_JOINT_KINDS, LEG_JOINTS, SIDES
 
-WORLD_FRAME = "world"
+WORLD_FRAME = "odom"
 BASE_LINK = "base_link"
 
 
+_LINK_OF_KIND = dict(zip(LEG_JOINT_KINDS, LEG_LINKS))
+
+
 def link_name(joint: str) -> str:
-    """The link a joint turns (the convention of the module docstring)."""
-    return f"{joint}_link"
+    """The link a joint turns (the convention of the module docstring): ``knee_pitch_left`` -> ``shank_left``."""
+    kind, _, side = joint.rpartition("_")
+    return f"{_LINK_OF_KIND[kind]}_{side}"
 
 
 def joint_axis(kind: str, side: str) -> tuple[float, float, float]:
@@ -91,7 +96,7 @@ class LinkTransforms:
         self.frames = joint_frames(geometry)
 
     def transforms(self, joints, angles_rad, root_m, root_rpy_rad=(0.0, 0.0, 0.0)) -> list[Transform]:
-        """world -> base_link from the root pose, then every leg joint (a joint missing from ``joints`` is at 0,
+        """odom -> base_link from the root pose, then every leg joint (a joint missing from ``joints`` is at 0,
         as a held joint is)."""
         angle = dict(zip(joints, (float(a) for a in angles_rad)))
         out = [Transform(WORLD_FRAME, BASE_LINK, tuple(float(v) for v in root_m), quaternion_rpy(*map(float, root_rpy_rad)))]

@@ -3,7 +3,7 @@
 The session (or the app around it) fills a :class:`FrameTelemetry` once a frame and calls
 ``observer.on_frame(record)``; it never waits on what the observer does with it (an observer must
 return within a small fraction of a frame: tools/bench_view.py measures it). Angles are radians,
-lengths metres, times seconds on the walk's clock from its start; positions are in the world frame
+lengths metres, times seconds on the walk's clock from its start; positions are in the world frame ``odom``
 (REP-103: x forward, y left, z up, the floor at z = 0).
 """
 

@@ -59,7 +59,8 @@ def test_tree_names_and_held_joints():
     assert transforms[0].parent == WORLD_FRAME and transforms[0].child == BASE_LINK
     assert [t.child for t in transforms] == list(link_names())
     assert {t.parent for t in transforms[1:]} <= set(link_names())
-    held = {t.child: t.rotation_xyzw for t in transforms if t.child != "knee_pitch_left_link"}
+    assert link_name("knee_pitch_left") == "shank_left" and link_name("ankle_roll_right") == "foot_right"
+    held = {t.child: t.rotation_xyzw for t in transforms if t.child != "shank_left"}
     assert all(q == (0.0, 0.0, 0.0, 1.0) for q in held.values())  # joints not given stand at 0
 
 

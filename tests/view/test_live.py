@@ -96,8 +96,9 @@ def test_a_foxglove_client_sees_joints_and_transforms_and_steers():
     assert goals.name == list(LEG_JOINTS)
     assert np.allclose(goals.position, goals.position[0]) and goals.position[0] >= 0  # one frame: 0.01 k for all
     tf = got["/tf"].transforms
-    assert (tf[0].header.frame_id, tf[0].child_frame_id) == ("world", "base_link")
-    assert [t.child_frame_id for t in tf[1:]] == [f"{j}_link" for j in LEG_JOINTS]
+    assert (tf[0].header.frame_id, tf[0].child_frame_id) == ("odom", "base_link")
+    assert [t.child_frame_id for t in tf[1:]] == [f"{link}_{side}" for side in ("left", "right")
+                                                  for link in ("hip_yaw", "hip_roll", "thigh", "shank", "ankle", "foot")]
     assert (got["command"].vx_m_s, got["command"].vy_m_s) == (0.05, -0.02)
     assert got["command"].wz_deg_s == pytest.approx(np.degrees(0.3))
     assert got["silent"].command.is_still and any("no Twist" in m for m in got["silent"].messages)
