@@ -152,6 +152,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "(N s, positive to the left) in the middle of a step half-way through the walk")
     p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (three-quarter view)")
     p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
+    _view_options(p)
 
     p = parser.commands["check"] = _command(sub, "check")
     p.add_argument("file", help="trajectory (.csv, .npz) or bus recording (.jsonl)")
@@ -269,6 +270,12 @@ def _closed_output() -> int:
     except (OSError, ValueError):
         pass
     return EXIT_BROKEN_PIPE
+
+
+def _view_options(p: argparse.ArgumentParser) -> None:
+    from gaitbot.app.view_options import add_view_options  # light: the view room is imported only when used
+
+    add_view_options(p)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -12,6 +12,7 @@ import sys
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
 from gaitbot.app.progress import callback, progress
+from gaitbot.app.view_options import open_view
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.log import BusRecorder, RecordingFailed
@@ -113,16 +114,21 @@ def run(args) -> int:
         print(f"note: {note}", file=sys.stderr)
     health = HealthMonitor.for_robot(config, _warn_line, clock.now)
     what = "simulating" if sim is not None else "walking"
+    view = None
     try:
+        view = open_view(args, config, trajectory, planned, health, not isinstance(clock, VirtualClock))
         with progress(what, total=len(frames), unit="frame") as bar:
+            status = _status(bar, walker.heel_strikes, source.settings.rate_hz, health)
             result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
                                   max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
                                   torque_off_on_exit=config.bus.torque_off_on_exit,
-                                  on_frame=_status(bar, walker.heel_strikes, source.settings.rate_hz, health),
+                                  on_frame=view.chain(status) if view else status,
                                   setup_writes=gain_writes(config), health=health)
     finally:
         if recorder is not None:
             recorder.close()
+        if view is not None:
+            view.close()
     for note in getattr(bus, "open_notes", []):
         print(f"note: {note}", file=sys.stderr)
     if sim is not None and args.json:

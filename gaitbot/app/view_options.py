@@ -1,0 +1,108 @@
+"""``--mcap FILE`` and ``--foxglove [HOST:PORT]`` (walk, drive): their options and the observer they make.
+
+The command adds the options with :func:`add_view_options` and makes a :class:`WalkView` with
+:func:`open_view` before its session; the view room does the work (gaitbot.view, docs/live-view.md).
+Neither library is needed unless asked for: without ``gaitbot[view]`` installed the option fails in one line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+DEFAULT_FOXGLOVE = "127.0.0.1:8765"  # gaitbot.view.live's default: loopback only
+
+
+def host_port(text: str) -> tuple[str, int]:
+    """``--foxglove [HOST:]PORT`` or ``HOST`` (port 8765); PORT 0 picks a free port."""
+    host, colon, port_text = text.rpartition(":")
+    if not colon:
+        host, port_text = ("", text) if text.isdigit() else (text, "8765")
+    port = int(port_text) if port_text.isdigit() else -1
+    if not 0 <= port <= 65535 or host.startswith("["):
+        raise argparse.ArgumentTypeError(f"expected [HOST:]PORT with PORT 0..65535 (default {DEFAULT_FOXGLOVE}), "
+                                         f"got {text!r}")
+    return host or "127.0.0.1", port
+
+
+def mcap_path(text: str) -> str:
+    """``--mcap FILE``: a file that can be written, checked before any work is done."""
+    from gaitbot.app.options import UsageError, check_output_path, file_option
+
+    try:
+        check_output_path(Path(file_option(text, "--mcap")), "--mcap")
+    except UsageError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("--mcap: ").removeprefix("--mcap ")) from None
+    except OSError as exc:  # a name the OS refuses (too long, a loop)
+        raise argparse.ArgumentTypeError(f"cannot write there ({exc.strerror or exc})") from None
+    return text
+
+
+def add_view_options(p) -> None:
+    p.add_argument("--mcap", metavar="FILE", type=mcap_path, help="write the walk's telemetry (joints, transforms, CoM, ZMP, feet, "
+                   "servo health) to this MCAP file (ROS 2 messages: Foxglove and ros2 bag open it)")
+    p.add_argument("--foxglove", nargs="?", const=host_port(DEFAULT_FOXGLOVE), type=host_port, metavar="HOST:PORT",
+                   help="serve the same telemetry live to Foxglove (default 127.0.0.1:8765; another HOST is reachable "
+                   "from the network) and take its Teleop panel's Twists on /cmd_vel (drive)")
+
+
+class WalkView:
+    """The observer of one walk (gaitbot.view.publisher.TelemetryPublisher over the asked-for sinks) and the
+    planned frames it reads from; ``teleop`` is the Foxglove command source when --foxglove is on."""
+
+    def __init__(self, publisher, frames, teleop=None) -> None:
+        self.publisher, self.frames, self.teleop = publisher, frames, teleop
+        self.health = None  # a HealthMonitor, summarised in each frame when set
+
+    def on_frame(self, k: int, **extra) -> None:
+        """Frame k of the planned walk (the session's walk-frame index), with what the session adds."""
+        from gaitbot.view.telemetry import health_of
+
+        self.publisher.on_frame(self.frames.frame(k, health=health_of(self.health), **extra))
+
+    def chain(self, on_frame):
+        """A session ``on_frame(k, stats)`` callback that also feeds the view."""
+        def both(k: int, stats) -> None:
+            self.on_frame(k)
+            if on_frame is not None:
+                on_frame(k, stats)
+        return both
+
+    def close(self) -> None:
+        self.publisher.close()
+        for note in self.publisher.notes:
+            print(f"note: {note}", file=sys.stderr)
+
+
+def open_view(args, config, goals, planned=None, health=None, realtime: bool = True) -> WalkView | None:
+    """The view of ``args.mcap`` / ``args.foxglove`` for this walk, or None when neither was asked for;
+    ``realtime``: the walk runs on a real clock (a full telemetry queue then drops a frame, never waits)."""
+    mcap, foxglove = getattr(args, "mcap", None), getattr(args, "foxglove", None)
+    if mcap is None and foxglove is None:
+        return None
+    from gaitbot.app.options import UsageError
+    from gaitbot.view.live import ViewOptionError
+    from gaitbot.view.publisher import BackgroundPublisher, TelemetryPublisher
+    from gaitbot.view.walk_frames import PlannedFrames
+
+    sinks, teleop = [], None
+    try:
+        if mcap is not None:
+            from gaitbot.view.mcap_log import McapSink
+            sinks.append(McapSink(mcap))
+        if foxglove is not None:
+            from gaitbot.view.live import FoxgloveSink
+            from gaitbot.view.teleop import TeleopSource
+            live = FoxgloveSink(*foxglove)
+            print(f"foxglove: ws://{live.host}:{live.port} (open it in Foxglove: docs/live-view.md)", file=sys.stderr)
+            sinks.append(live)
+            teleop = TeleopSource(live.inbox)
+        publisher = BackgroundPublisher(TelemetryPublisher(config.body.geometry, sinks), lossless=not realtime)
+    except (ImportError, OSError, ViewOptionError) as exc:
+        for sink in sinks:
+            sink.close()
+        raise UsageError(str(exc) if not isinstance(exc, OSError) else f"--mcap {mcap}: {exc.strerror or exc}") from None
+    view = WalkView(publisher, PlannedFrames(config, goals, planned), teleop)
+    view.health = health
+    return view

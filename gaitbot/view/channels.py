@@ -1,0 +1,118 @@
+"""The channels of a walk's telemetry: topic, ROS 2 message type, and the messages of one frame.
+
+The same channels go to an MCAP log and to a live Foxglove server (docs/live-view.md lists them). A channel
+whose data a walk lacks (no read-back on a dry run, no IMU, no command) carries nothing; every other
+channel carries one message a frame, stamped with the frame's time.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from gaitbot.view.link_frames import WORLD_FRAME, LinkTransforms, quaternion_rpy
+from gaitbot.view.telemetry import FrameTelemetry
+
+CHANNELS = {
+    "/joint_goals": "sensor_msgs/msg/JointState",
+    "/joint_states": "sensor_msgs/msg/JointState",
+    "/tf": "tf2_msgs/msg/TFMessage",
+    "/walk_command": "geometry_msgs/msg/Twist",
+    "/imu": "sensor_msgs/msg/Imu",
+    "/com": "geometry_msgs/msg/PointStamped",
+    "/zmp": "geometry_msgs/msg/PointStamped",
+    "/com_measured": "geometry_msgs/msg/PointStamped",
+    "/zmp_measured": "geometry_msgs/msg/PointStamped",
+    "/support_polygon": "geometry_msgs/msg/PolygonStamped",
+    "/footprints": "geometry_msgs/msg/PoseArray",
+    "/diagnostics": "diagnostic_msgs/msg/DiagnosticArray",
+}
+"""Topic -> ROS 2 message type, every channel the view can write."""
+
+IMU_FRAME = "imu_link"
+_UNKNOWN_COVARIANCE = [-1.0] + [0.0] * 8  # sensor_msgs/Imu: element 0 = -1 means "no estimate"
+
+
+def header(stamp_ns: int, frame_id: str = "") -> dict:
+    return {"stamp": {"sec": stamp_ns // 1_000_000_000, "nanosec": stamp_ns % 1_000_000_000}, "frame_id": frame_id}
+
+
+def _xyz(v) -> dict:
+    return {"x": float(v[0]), "y": float(v[1]), "z": float(v[2]) if len(v) > 2 else 0.0}
+
+
+def _quaternion(q) -> dict:
+    return {"x": q[0], "y": q[1], "z": q[2], "w": q[3]}
+
+
+def joint_state(stamp_ns: int, joints, angles_rad) -> dict:
+    """Joints whose angle is known (NaN: not read this frame) with their positions in radians."""
+    pairs = [(n, float(a)) for n, a in zip(joints, angles_rad) if math.isfinite(a)]
+    return {"header": header(stamp_ns), "name": [n for n, _ in pairs], "position": [a for _, a in pairs],
+            "velocity": [], "effort": []}
+
+
+def rotation_xyzw(rotation: np.ndarray) -> tuple[float, float, float, float]:
+    """The unit quaternion of a rotation matrix (Shepperd's method: the largest diagonal term first)."""
+    m = rotation
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    if trace > 0:
+        s = 2.0 * math.sqrt(1.0 + trace)
+        return ((m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, s / 4)
+    i = int(np.argmax([m[0, 0], m[1, 1], m[2, 2]]))
+    j, k = (i + 1) % 3, (i + 2) % 3
+    s = 2.0 * math.sqrt(1.0 + m[i, i] - m[j, j] - m[k, k])
+    q = [0.0, 0.0, 0.0, (m[k, j] - m[j, k]) / s]
+    q[i], q[j], q[k] = s / 4, (m[j, i] + m[i, j]) / s, (m[k, i] + m[i, k]) / s
+    return tuple(float(v) for v in q)
+
+
+def _diagnostics(stamp_ns: int, health) -> dict:
+    values = [(key, value) for key, value in (("hottest_c", health.hottest_c), ("lowest_voltage_v", health.lowest_voltage_v),
+                                              ("peak_load_pct", health.peak_load_pct)) if value is not None]
+    return {"header": header(stamp_ns), "status": [{
+        "level": int(health.level), "name": "gaitbot: servos", "message": health.message, "hardware_id": "servos",
+        "values": [{"key": k, "value": f"{v:g}"} for k, v in values]}]}
+
+
+def _imu(stamp_ns: int, imu) -> dict:
+    orientation = imu.orientation_xyzw
+    return {"header": header(stamp_ns, IMU_FRAME),
+            "orientation": _quaternion(orientation if orientation is not None else (0.0, 0.0, 0.0, 1.0)),
+            "orientation_covariance": [0.0] * 9 if orientation is not None else _UNKNOWN_COVARIANCE,
+            "angular_velocity": _xyz(imu.angular_velocity_rad_s), "angular_velocity_covariance": [0.0] * 9,
+            "linear_acceleration": _xyz(imu.linear_acceleration_m_s2), "linear_acceleration_covariance": [0.0] * 9}
+
+
+def frame_messages(frame: FrameTelemetry, stamp_ns: int, links: LinkTransforms) -> list[tuple[str, dict]]:
+    """(topic, message) of every channel that has data this frame (messages as nested dicts)."""
+    out = [("/joint_goals", joint_state(stamp_ns, frame.joints, frame.goals_rad))]
+    if frame.read_back_rad is not None:
+        out.append(("/joint_states", joint_state(stamp_ns, frame.joints, frame.read_back_rad)))
+    out.append(("/tf", {"transforms": [
+        {"header": header(stamp_ns, t.parent), "child_frame_id": t.child,
+         "transform": {"translation": _xyz(t.translation), "rotation": _quaternion(t.rotation_xyzw)}}
+        for t in links.transforms(frame.joints, frame.goals_rad, frame.root_m, frame.root_rpy_rad)]}))
+    if frame.command is not None:
+        vx, vy, wz = frame.command
+        out.append(("/walk_command", {"linear": _xyz((vx, vy, 0.0)), "angular": _xyz((0.0, 0.0, wz))}))
+    if frame.imu is not None:
+        out.append(("/imu", _imu(stamp_ns, frame.imu)))
+    for topic, point in (("/com", frame.com_m), ("/zmp", frame.zmp_m), ("/com_measured", frame.measured_com_m),
+                         ("/zmp_measured", frame.measured_zmp_m)):
+        if point is not None:
+            out.append((topic, {"header": header(stamp_ns, WORLD_FRAME), "point": _xyz(point)}))
+    if frame.support_m is not None:
+        out.append(("/support_polygon", {"header": header(stamp_ns, WORLD_FRAME), "polygon": {
+            "points": [{"x": float(x), "y": float(y), "z": 0.0} for x, y in frame.support_m]}}))
+    if frame.soles_m is not None:
+        out.append(("/footprints", {"header": header(stamp_ns, WORLD_FRAME), "poses": [
+            {"position": _xyz(centre), "orientation": _quaternion(rotation_xyzw(rotation))}
+            for centre, rotation in frame.soles_m.values()]}))
+    if frame.health is not None:
+        out.append(("/diagnostics", _diagnostics(stamp_ns, frame.health)))
+    return out
+
+
+
