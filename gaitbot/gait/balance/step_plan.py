@@ -30,10 +30,11 @@ STAND_KNEE_DEG = 10.0  # standing knees: bent this much, so the legs reach where
 START_PAUSE_S = 0.3
 END_STAND_S = 1.0
 PLAN_KEYS = ("zmp", "ankles", "root_z", "share_left", "cops", "swinging", "yaw")
-YAW_WINDOW = (0.2, 0.8)
-"""The swing foot turns between these shares of its swing (smootherstep: zero yaw rate and acceleration at
-both ends), when its sole is at least the clearance up (gaitbot.gait.segments.CLEARANCE_WINDOW): it never
-turns while scraping the floor."""
+YAW_WINDOW = (0.1, 0.9)
+"""The swing foot turns while its ankle point goes from 10% to 90% of the way to its foothold (the yaw a
+smootherstep of that share: zero yaw rate and acceleration at lift-off and touch-down, and none while the
+sole leaves or meets the floor). Tying the turn to the position (not to time) makes the swing's path in
+the plane one curve, whatever the step's timing: the planner checks the feet's clearance along it."""
 
 
 def feedforward_weight(frame, last_frame: float, rate_hz: float):
@@ -46,10 +47,11 @@ def feedforward_weight(frame, last_frame: float, rate_hz: float):
     return np.minimum(smootherstep(frame / n), smootherstep((last_frame - frame) / n))
 
 
-def swing_yaw_share(tau):
-    """The share of its turn the swing foot has made at swing time share ``tau`` (0 -> 1 over YAW_WINDOW)."""
+def swing_yaw_share(position_share):
+    """The share of its turn the swing foot has made when its ankle point is ``position_share`` of the way
+    to its foothold (0 -> 1 over YAW_WINDOW)."""
     a, b = YAW_WINDOW
-    return smootherstep((np.asarray(tau, dtype=float) - a) / (b - a))
+    return smootherstep((np.asarray(position_share, dtype=float) - a) / (b - a))
 
 
 def crouch_hip_height_m(geometry: BodyGeometry, knee_deg: float) -> float:
@@ -205,7 +207,7 @@ class StepPlanner:
         ankles[:, i, 2] = g.ankle_height_m + h
         ankles[-1, i] = [new.x_m, new.y_m, g.ankle_height_m]  # lands exactly on its foothold
         yaw = np.repeat(feet_yaw[None], n_ss, 0)
-        yaw[:, i] = old.yaw_rad + swing_yaw_share(tau) * (new.yaw_rad - old.yaw_rad)
+        yaw[:, i] = old.yaw_rad + swing_yaw_share(p) * (new.yaw_rad - old.yaw_rad)
         yaw[-1, i] = new.yaw_rad
         cops = np.repeat(feet_cops[None], n_ss, 0)
         cops[:, i] += ankles[:, i, :2] - feet_ankles[i, :2]  # the swing foot's point goes with it (it bears no load)

@@ -205,6 +205,14 @@ class BalancedWalker:
             if self._primed:
                 self._replan_lookahead()
 
+    def lead_with(self, side: str) -> None:
+        """Make ``side`` the first foot to swing (a sidestep or a turn leads with the foot on its side)."""
+        if self.planned_steps:
+            raise RuntimeError("the first step is already planned")
+        self._state.stance_next = "right" if side == "left" else "left"
+        if not self._batch:
+            self._commit()
+
     @property
     def next_swing_side(self) -> str:
         """The foot the next queued step swings."""
@@ -477,8 +485,13 @@ def plan_balanced_walk(body: BodyModel, step_lengths, gait: BalancedGaitSettings
     """A closed walker with every step queued (nothing computed past the plan yet)."""
     walker = BalancedWalker(body, gait, balance, **options)
     walker._batch = True
-    for length in step_lengths:
-        walker.append_step(length)
+    for step in step_lengths:  # a length (m), or a steered step (gaitbot.gait.steer.planner.Footstep)
+        if hasattr(step, "foothold"):
+            if not walker.planned_steps and step.foothold.side != walker.next_swing_side:
+                walker.lead_with(step.foothold.side)
+            walker.append_footstep(step.foothold, step.length_m)
+        else:
+            walker.append_step(step)
     walker._batch = False
     walker.finish()
     return walker
