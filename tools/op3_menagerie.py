@@ -160,6 +160,9 @@ class ForeignResult:
     max_abs_yaw_deg: float = 0.0
     torso_roll_rms_deg: float = 0.0
     torso_pitch_rms_deg: float = 0.0
+    final_x_m: float = 0.0  # the torso's last position from its start (world)
+    final_y_m: float = 0.0
+    heading_deg: float = 0.0  # the torso's yaw change, unwrapped (a full turn is 360)
 
 
 def play(trajectory, rate_hz: float, friction: float = 1.0, push_n_s: float = 0.0, push_at_s: float = 0.0) -> ForeignResult:
@@ -215,6 +218,8 @@ def play(trajectory, rate_hz: float, friction: float = 1.0, push_n_s: float = 0.
     result.distance_travelled_m = float(data.qpos[0] - start[0])
     result.lateral_drift_m = float(data.qpos[1] - start[1] - (root[-1, 1] - root[0, 1]))
     result.max_abs_yaw_deg = float(np.abs(rpy[:, 2]).max())
+    result.final_x_m, result.final_y_m = float(data.qpos[0] - start[0]), float(data.qpos[1] - start[1])
+    result.heading_deg = float(np.degrees(np.unwrap(np.radians(rpy[:, 2])))[-1] - rpy[0, 2])
     result.torso_roll_rms_deg = float(np.sqrt(np.mean(rpy[:, 0] ** 2)))
     result.torso_pitch_rms_deg = float(np.sqrt(np.mean(rpy[:, 1] ** 2)))
     return result

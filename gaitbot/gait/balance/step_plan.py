@@ -134,8 +134,11 @@ class StepPlanner:
         self.walk_root_z = crouch_hip_height_m(g, balance.crouch_knee_deg) + g.ankle_height_m + g.hip_below_root_m
 
     def start_feet(self) -> dict:
+        return self.start_feet_of(self.geometry)
+
+    @staticmethod
+    def start_feet_of(g: BodyGeometry) -> dict:
         """Both heels at x = 0 (the planar walker's origin), ankles hip_width apart."""
-        g = self.geometry
         return {side: FootPlacement(side, g.heel_back_m, SIDE_SIGN[side] * g.hip_width_m / 2) for side in SIDES}
 
     def start(self) -> PlanState:
