@@ -30,7 +30,7 @@ SQUARE = "\n".join(
         f'{{"t": {k * 22.0:g}, "vx": 0.04, "vy": 0.0, "wz": 0.0}}',
         f'{{"t": {k * 22.0 + 12.5:g}, "vx": 0.0, "vy": 0.0, "wz": 0.0}}',
         f'{{"t": {k * 22.0 + 13.0:g}, "vx": 0.0, "vy": 0.0, "wz": 10.0}}',
-    )) + '\n{"t": 87.0, "stop": true}\n'
+    )) + '\n{"t": 88.0, "stop": true}\n'
 """A square of 0.5 m sides: 12.5 s at 0.04 m/s, a pause, a quarter turn at 10 deg/s (9 s), four times."""
 
 WALKS = {
@@ -104,13 +104,21 @@ def menagerie_sole_gap_m(trajectory) -> float:
     return gap
 
 
+def gaitbot_stiffness(robot: str) -> float:
+    """The leg servos' stiffness gaitbot writes (N m/rad; the same for every OP3 leg joint)."""
+    from gaitbot.app.options import load_robot
+    from gaitbot.robot.balanced_walk import servo_stiffness_nm_per_rad
+
+    return float(np.mean(servo_stiffness_nm_per_rad(load_robot(robot))))
+
+
 def judge(robot: str, name: str, goals: bool = False) -> Judged:
     from gaitbot.app.steer_walk import commanded_pose, planned_pose
 
     with tempfile.TemporaryDirectory() as tmp:
         plan, trajectory = plan_walk(robot, name, tmp)
     played = plan.walk.trajectory(goals=goals)
-    r = op3_menagerie.play(played, plan.walker.rate_hz)
+    r = op3_menagerie.play(played, plan.walker.rate_hz, kp_nm_per_rad=gaitbot_stiffness(robot))
     return Judged(name, commanded_pose(plan.schedule), planned_pose(plan), (r.final_x_m, r.final_y_m, r.heading_deg),
                   r.fell, menagerie_sole_gap_m(trajectory))
 
@@ -124,13 +132,13 @@ def row(j: Judged) -> str:
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("walks", nargs="*", default=list(WALKS), choices=list(WALKS))
+    p.add_argument("walks", nargs="*", help=f"walks to judge (default all: {', '.join(WALKS)})")
     p.add_argument("--robot", default="op3")
     p.add_argument("--goals", action="store_true", help="play the goals (sag feedforward) instead of the planned angles")
     args = p.parse_args(argv)
     print("| walk | commanded (x m, y m, heading deg) | planned | Menagerie OP3 | fell | least sole gap mm |")
     print("|---|---|---|---|---|---|")
-    for name in args.walks:
+    for name in args.walks or list(WALKS):
         print(row(judge(args.robot, name, args.goals)), flush=True)
     return 0
 

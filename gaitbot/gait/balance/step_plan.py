@@ -30,8 +30,8 @@ STAND_KNEE_DEG = 10.0  # standing knees: bent this much, so the legs reach where
 START_PAUSE_S = 0.3
 END_STAND_S = 1.0
 PLAN_KEYS = ("zmp", "ankles", "root_z", "share_left", "cops", "swinging", "yaw")
-YAW_WINDOW = (0.1, 0.9)
-"""The swing foot turns while its ankle point goes from 10% to 90% of the way to its foothold (the yaw a
+YAW_WINDOW = (0.05, 0.7)
+"""The swing foot turns while its ankle point goes from 5% to 70% of the way to its foothold (the yaw a
 smootherstep of that share: zero yaw rate and acceleration at lift-off and touch-down, and none while the
 sole leaves or meets the floor). Tying the turn to the position (not to time) makes the swing's path in
 the plane one curve, whatever the step's timing: the planner checks the feet's clearance along it."""
@@ -45,6 +45,21 @@ def feedforward_weight(frame, last_frame: float, rate_hz: float):
     frame = np.asarray(frame, dtype=float)
     n = SETTLE_S * rate_hz
     return np.minimum(smootherstep(frame / n), smootherstep((last_frame - frame) / n))
+
+
+STEERED_PROGRESSION_END = 0.6
+ASIDE_M = 0.015
+"""A swing that goes backward, or more than ASIDE_M sideways (in the stance foot's frame), is over its
+foothold by 60% of the swing (others: [balance] progression_end): soft servos lag, and a foot still
+travelling back or aside when it comes down lands short (on the Menagerie OP3 backward steps land 85% of
+their length with 0.85, 89% with 0.6, and sidesteps turn the robot 5 deg per 0.3 m: docs/steering.md)."""
+
+
+def back_or_aside(stance: FootPlacement, old: FootPlacement, new: FootPlacement) -> bool:
+    """Whether the swing from ``old`` to ``new`` goes backward or aside (ASIDE_M), in the stance's frame."""
+    c, s = math.cos(stance.yaw_rad), math.sin(stance.yaw_rad)
+    dx, dy = new.x_m - old.x_m, new.y_m - old.y_m
+    return c * dx + s * dy < 0.0 or abs(-s * dx + c * dy) > ASIDE_M
 
 
 def swing_yaw_share(position_share):
@@ -199,9 +214,11 @@ class StepPlanner:
                    feet_yaw)
         n_ss = t.ss_frames
         progression, lift = self.swing.at(math.hypot(new.x_m - old.x_m, new.y_m - old.y_m))
+        progression_end = min(b.progression_end, STEERED_PROGRESSION_END) if back_or_aside(stance, old, new) \
+            else b.progression_end
         peak = self.swing.peak_for_clearance(lift, self.clearance_m)
         tau = np.arange(1, n_ss + 1) / n_ss
-        p = np.interp(np.minimum(tau / b.progression_end, 1.0), self.swing.tau, progression)
+        p = np.interp(np.minimum(tau / progression_end, 1.0), self.swing.tau, progression)
         h = peak * np.interp(tau, self.swing.tau, lift)
         ankles = np.repeat(feet_ankles[None], n_ss, 0)
         i = SIDES.index(swing_side)
