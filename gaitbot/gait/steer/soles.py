@@ -54,15 +54,21 @@ def _depth(px, py, poly) -> float:
     return depth
 
 
+COLLINEAR_M2 = 1e-15
+"""Orientations (twice a triangle's area, m^2) below this count as collinear: side by side soles' toe
+edges lie on one line, and rounding must not make them cross."""
+
+
 def _cross(p, q) -> bool:
-    """Whether an edge of p crosses an edge of q (properly)."""
-    def orient(a, b, c):
-        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    """Whether an edge of p crosses an edge of q (properly: collinear touching does not count)."""
+    def side(a, b, c) -> int:
+        o = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+        return 0 if abs(o) < COLLINEAR_M2 else (1 if o > 0 else -1)
     for i in range(len(p)):
         a, b = p[i], p[(i + 1) % len(p)]
         for j in range(len(q)):
             c, d = q[j], q[(j + 1) % len(q)]
-            if orient(a, b, c) * orient(a, b, d) < 0 and orient(c, d, a) * orient(c, d, b) < 0:
+            if side(a, b, c) * side(a, b, d) < 0 and side(c, d, a) * side(c, d, b) < 0:
                 return True
     return False
 
