@@ -123,6 +123,37 @@ def judge(robot: str, name: str, goals: bool = False) -> Judged:
                   r.fell, menagerie_sole_gap_m(trajectory))
 
 
+def play_own(robot: str, name: str) -> tuple[tuple, tuple, bool]:
+    """(planned pose, simulated pose, fell) of a walk on gaitbot's own free-floating simulation, sent the
+    goals at the stiffness gaitbot writes (as ``gaitbot walk --sim`` walks it)."""
+    from gaitbot.app.options import load_robot
+    from gaitbot.app.steer_walk import planned_pose
+    from gaitbot.sim.metrics import WalkMeter
+    from gaitbot.sim.physics import SimRobot
+    from gaitbot.sim.walk import walk_plan
+
+    with tempfile.TemporaryDirectory() as tmp:
+        plan, _ = plan_walk(robot, name, tmp)
+    config = load_robot(robot)
+    rate = plan.walker.rate_hz
+    goals = plan.walk.trajectory(goals=True)
+    sim = SimRobot(config, rate, support="free")
+    wp = walk_plan(plan, goals)
+    sim.place(wp.start_angles_rad, wp.start_root_m)
+    for i in range(len(sim.joint_names)):
+        sim.set_full_torque_error(i, config.servo.full_torque_error_deg)
+        sim.set_torque(i, True)
+    meter = WalkMeter(sim, wp)
+    sim.observers.append(meter)
+    angles = goals.angles_of(sim.joint_names)
+    for k in range(len(angles) + round(rate)):
+        for i, angle in enumerate(angles[min(k, len(angles) - 1)]):
+            sim.set_goal(i, float(angle))
+        sim.advance_to((k + 1) / rate)
+    r = meter.report(wp, False)
+    return planned_pose(plan), (r.distance_travelled_m, r.lateral_drift_m + wp.lateral_m, r.heading_deg), r.fell
+
+
 def row(j: Judged) -> str:
     def pose(p):
         return f"({p[0]:6.3f}, {p[1]:6.3f}, {p[2]:6.1f})"

@@ -260,7 +260,8 @@ def check_sources(parser: argparse.ArgumentParser, args) -> None:
         args.demo = True  # said by the walk once its other options are found good (app/walk.py)
         return
     extra = " or --trajectory" if args.command == "walk" else ""
-    own.error(f"give --steps, --distance, --velocity, --commands or --terrain{extra} (e.g. --distance 1.0)")
+    own.error(f"give --steps, --distance or --terrain{extra} (e.g. --distance 1.0), or steer with --velocity "
+              "VX,VY,WZ --duration S or --commands FILE")
 
 
 def _closed_output() -> int:

@@ -100,6 +100,11 @@ class BalancedWalk:
     yaw_rad: np.ndarray | None = None  # (n, 2) each foot's yaw where the walk turns; None: straight
 
     @property
+    def feet_yaw_rad(self) -> np.ndarray:
+        """Each foot's yaw over frames (n, 2) (zeros for a straight walk)."""
+        return np.zeros((len(self.t_s), 2)) if self.yaw_rad is None else self.yaw_rad
+
+    @property
     def torso_yaw_rad(self) -> np.ndarray:
         """The torso's yaw over frames (the mean of the feet's; zeros for a straight walk)."""
         return np.zeros(len(self.t_s)) if self.yaw_rad is None else torso_yaw(self.yaw_rad)
