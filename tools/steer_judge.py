@@ -134,6 +134,17 @@ def play_own(robot: str, name: str) -> tuple[tuple, tuple, bool]:
 
     with tempfile.TemporaryDirectory() as tmp:
         plan, _ = plan_walk(robot, name, tmp)
+    return play_plan_own(robot, plan)
+
+
+def play_plan_own(robot: str, plan) -> tuple[tuple, tuple, bool]:
+    """play_own for a planned steered walk."""
+    from gaitbot.app.options import load_robot
+    from gaitbot.app.steer_walk import planned_pose
+    from gaitbot.sim.metrics import WalkMeter
+    from gaitbot.sim.physics import SimRobot
+    from gaitbot.sim.walk import walk_plan
+
     config = load_robot(robot)
     rate = plan.walker.rate_hz
     goals = plan.walk.trajectory(goals=True)
