@@ -129,6 +129,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help="trajectory (.csv or .npz), or an eigen-gait model (.npz from gaitbot eigen fit)")
     p.add_argument("-o", "--output", required=True, help="picture file, e.g. walk.png (or .svg, .pdf)")
     _robot_options(p, "robot config whose leg walked the trajectory (default xl430-biped)")
+    p.add_argument("--commands", metavar="FILE", help="a steered walk's commands (JSON Lines), drawn over time")
     _leg_options(p, "if the trajectory was made with another leg")
     p.add_argument("--clearance", type=float, metavar="M",
                    help="clearance line drawn on the foot heights, metres (default: the robot's clearance_m)")
