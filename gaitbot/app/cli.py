@@ -32,6 +32,7 @@ import warnings  # noqa: E402
 from gaitbot import __version__  # noqa: E402
 from gaitbot.app.help import COMMAND_HELP, DESCRIPTION, EPILOG, HelpFormatter  # noqa: E402
 from gaitbot.app.robot import add_parser as add_robot_parser  # noqa: E402
+from gaitbot.app.steer_options import add_steer_options, steer_sources  # noqa: E402
 from gaitbot.errors import UserError  # noqa: E402
 from gaitbot.stream.signals import StopSignals, Terminated  # noqa: E402 - light: rooms come with the commands
 
@@ -92,6 +93,7 @@ def _walk_inputs(p: argparse.ArgumentParser, demo: bool = False) -> None:
                    "(default: the robot's cycle_s)")
     p.add_argument("--terrain", metavar="FILE", help="walk a terrain course (TOML, see config/terrain/) instead of "
                    "--steps/--distance")
+    add_steer_options(p)  # --velocity/--duration, --commands (gaitbot.app.steer_options)
 
 
 def _bus_options(p: argparse.ArgumentParser, dry_run_help: str) -> None:
@@ -128,6 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help="trajectory (.csv or .npz), or an eigen-gait model (.npz from gaitbot eigen fit)")
     p.add_argument("-o", "--output", required=True, help="picture file, e.g. walk.png (or .svg, .pdf)")
     _robot_options(p, "robot config whose leg walked the trajectory (default xl430-biped)")
+    p.add_argument("--commands", metavar="FILE", help="a steered walk's commands (JSON Lines), drawn over time")
     _leg_options(p, "if the trajectory was made with another leg")
     p.add_argument("--clearance", type=float, metavar="M",
                    help="clearance line drawn on the foot heights, metres (default: the robot's clearance_m)")
@@ -249,6 +252,9 @@ def check_sources(parser: argparse.ArgumentParser, args) -> None:
         return
     own = parser.commands[args.command]
     sources = [name for name in ("steps", "distance", "terrain", "trajectory") if getattr(args, name, None) is not None]
+    sources += steer_sources(args)
+    if "velocity" in sources and "distance" in sources:  # --velocity VX,0,0 --distance M: one straight walk
+        sources.remove("distance")
     if len(sources) > 1:
         own.error(f"give one of --{' / --'.join(sources)}, not several")
     if sources:
@@ -258,7 +264,8 @@ def check_sources(parser: argparse.ArgumentParser, args) -> None:
         args.demo = True  # said by the walk once its other options are found good (app/walk.py)
         return
     extra = " or --trajectory" if args.command == "walk" else ""
-    own.error(f"give --steps, --distance or --terrain{extra} (e.g. --distance 1.0)")
+    own.error(f"give --steps, --distance or --terrain{extra} (e.g. --distance 1.0), or steer with --velocity "
+              "VX,VY,WZ --duration S or --commands FILE")
 
 
 def _closed_output() -> int:

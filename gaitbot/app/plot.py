@@ -40,7 +40,13 @@ def run(args) -> int:
     if source.robot is not None and source.robot.is_3d and getattr(args, "terrain", None) is None:
         from gaitbot.plot.balance import plot_balance
 
-        write_output(out, lambda path: plot_balance(trajectory, source.robot, path, title=Path(args.file).name))
+        commands = None
+        if getattr(args, "commands", None) is not None:
+            from gaitbot.gait.steer.command import read_commands
+
+            commands = read_commands(file_option(args.commands, "--commands"))
+        write_output(out, lambda path: plot_balance(trajectory, source.robot, path, title=Path(args.file).name,
+                                                    commands=commands))
         print(f"wrote {out}")
         return 0
     terrain = None

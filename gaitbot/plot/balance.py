@@ -17,6 +17,7 @@ from gaitbot.check.preflight import robot_angles_deg
 from gaitbot.gait.joints import LEG_JOINT_KINDS
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.config import RobotConfig
+from gaitbot.plot.steer import draw_commands
 
 _COLOURS = {"left": "tab:blue", "right": "tab:red"}
 _KIND_COLOURS = dict(zip(LEG_JOINT_KINDS, ("tab:gray", "tab:purple", "tab:blue", "tab:orange", "tab:green",
@@ -36,7 +37,9 @@ def _footprints(trace, side: str) -> list[np.ndarray]:
     return out
 
 
-def plot_balance(trajectory: Trajectory, config: RobotConfig, out: Path, title: str = "") -> None:
+def plot_balance(trajectory: Trajectory, config: RobotConfig, out: Path, title: str = "", commands=None) -> None:
+    """Joint angles, the top view (footprints as the forward kinematics turns them, CoM, ZMP, support) and
+    the torso's attitude; with ``commands`` (a steered walk's timed commands) a fourth panel of them."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -45,9 +48,12 @@ def plot_balance(trajectory: Trajectory, config: RobotConfig, out: Path, title: 
 
     trace = balance_trace(config, trajectory, robot_angles_deg(config, trajectory))
     t = trajectory.t_s
-    fig = plt.figure(figsize=(12, 10), constrained_layout=True)
-    grid = fig.add_gridspec(3, 1, height_ratios=[1.0, 1.3, 0.6])
+    panels = 3 if commands is None else 4
+    fig = plt.figure(figsize=(12, 10 if commands is None else 12), constrained_layout=True)
+    grid = fig.add_gridspec(panels, 1, height_ratios=[1.0, 1.3, 0.6, 0.6][:panels])
     ax_angles, ax_top, ax_torso = (fig.add_subplot(grid[i]) for i in range(3))
+    if commands is not None:
+        draw_commands(fig.add_subplot(grid[3]), commands, float(t[-1]))
 
     for i, name in enumerate(trajectory.joints):
         kind, side = name.rsplit("_", 1)

@@ -1,0 +1,72 @@
+"""What steering costs per 60 Hz frame: the online balanced walker fed one planned step at a time.
+
+A drive's loop, without the input: every frame, if less than LOOKAHEAD_S of steps is queued, the footstep
+planner plans the next step from the current command (gaitbot.gait.steer.planner) and the walker appends it
+(rerunning its first preview stage over the look-ahead); then ``next_frame``. The command changes every
+few seconds (a turn, a sidestep, an arc, forward). Prints the per-frame time (p50, p99, max, ms, wall
+clock on this machine, one thread) with and without the frames that appended a step, and a step's
+planning time.
+
+    python tools/bench_steer.py [--robot op3] [--seconds 30]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+COMMANDS = ((0.0, 0.0, 12.0), (0.0, 0.03, 0.0), (0.04, 0.0, 8.0), (0.05, 0.0, 0.0), (-0.04, 0.0, 0.0))
+LOOKAHEAD_S = 1.2
+
+
+def main(argv=None) -> int:
+    from gaitbot.app.options import load_robot
+    from gaitbot.gait.steer.command import VelocityCommand
+    from gaitbot.robot.balanced_walk import balanced_gait_settings, balanced_walker
+    from gaitbot.robot.steered_walk import footstep_planner
+
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--robot", default="op3")
+    p.add_argument("--seconds", type=float, default=30.0)
+    args = p.parse_args(argv)
+    config = load_robot(args.robot)
+    gait = balanced_gait_settings(config)
+    walker = balanced_walker(config, gait)
+    planner = footstep_planner(config, gait)
+    rate = walker.rate_hz
+    frames, plan_times, appended = [], [], []
+    k = 0
+    while k < args.seconds * rate:
+        t0 = time.perf_counter()
+        queued_s = walker.plan_arrays()["zmp"].shape[0] / rate - k / rate
+        added = False
+        if queued_s < LOOKAHEAD_S:
+            command = VelocityCommand(*COMMANDS[int(k / rate / 6.0) % len(COMMANDS)])
+            p0 = time.perf_counter()
+            step = planner.next_step(command, walker.next_swing_side)
+            plan_times.append(time.perf_counter() - p0)
+            walker.append_footstep(step.foothold, step.length_m)
+            added = True
+        frame = walker.next_frame()
+        frames.append(time.perf_counter() - t0)
+        appended.append(added)
+        k += 1
+        if frame is None:
+            break
+    f = 1e3 * np.array(frames)
+    a = np.array(appended)
+    print(f"{args.robot}: {len(f)} frames ({len(f) / rate:.0f} s), {a.sum()} steps appended while walking")
+    for label, x in (("every frame", f), ("frames without an append", f[~a]), ("frames that appended a step", f[a])):
+        print(f"  {label}: p50 {np.percentile(x, 50):.2f} ms, p99 {np.percentile(x, 99):.2f} ms, max {x.max():.2f} ms")
+    q = 1e3 * np.array(plan_times)
+    print(f"  planning one step: p50 {np.percentile(q, 50):.2f} ms, max {q.max():.2f} ms")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
