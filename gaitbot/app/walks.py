@@ -12,7 +12,7 @@ import numpy as np
 from gaitbot.app.options import UsageError, check_rate_option, file_option, gait_source, step_lengths
 from gaitbot.app.progress import callback, progress
 from gaitbot.gait.footfall import detect_heel_strikes
-from gaitbot.gait.segments import GaitGenerationError
+from gaitbot.gait.walk_segments import GaitGenerationError
 from gaitbot.gait.step_length import StepLengthError
 from gaitbot.gait.terrain.course_file import load_course
 from gaitbot.gait.terrain.footholds import CourseError

@@ -22,7 +22,7 @@ import numpy as np
 from .boulic import TABLE2_CYCLE_S
 from .geometry import LegGeometry
 from .planning import PlannedStep
-from .segments import CrouchSegment, GaitContext, SettleSegment, StepSegment
+from .walk_segments import CrouchSegment, GaitContext, SettleSegment, StepSegment
 from .step_length import StepLengthError, StepLengthInverse
 from .trajectory import HeelStrike, Trajectory
 
@@ -35,9 +35,9 @@ class WalkSettings:
     so that a step is a whole number of frames.
     clearance: least height of the whole swing sole from 20% to 80% of each swing.
     intermediate_steps: m of eq. 14, intermediate step lengths between consecutive steps.
-    crouch_knee_deg: knee bend of the start and end crouch (see segments.py for why).
+    crouch_knee_deg: knee bend of the start and end crouch (see walk_segments.py for why).
     settle_s: duration of the stand -> crouch and crouch -> stand phases.
-    pitch_limit_deg: the model's sole pitch is smoothly saturated to +- this (see segments.foot_of).
+    pitch_limit_deg: the model's sole pitch is smoothly saturated to +- this (see walk_segments.foot_of).
     """
 
     cycle_s: float = TABLE2_CYCLE_S

@@ -44,7 +44,7 @@ from ..geometry import LegGeometry
 from ..joints import LEG_JOINTS, PITCH_JOINTS, is_leg_joint
 from .align import align_to_reference, resample_cycle, sample_phases
 from .basis import fit_coefficients, make_basis
-from .examples import ExampleCycle
+from .example_cycles import ExampleCycle
 from .legs import PlanarLegs, SpatialLegs
 from .pose import leading_count, pose_pca
 
