@@ -13,6 +13,7 @@ import os
 import sys
 from pathlib import Path
 
+from gaitbot.app.arguments import REPLY_TIMEOUT_HELP, add_command
 from gaitbot.app.hardware import serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
 from gaitbot.bus.factory import make_robot_bus
@@ -53,6 +54,16 @@ def _confirm(yes: bool):
             print()
         return answer.strip().lower() in ("y", "yes")
     return confirm
+
+
+def add_parser(subparsers):
+    p = add_command(subparsers, "calibrate")
+    p.add_argument("--robot", help="robot config (default xl430-biped)")
+    p.add_argument("-o", "--output", required=True, help="calibration file to write (.toml)")
+    p.add_argument("--port", help="serial port (default: the robot config's)")
+    p.add_argument("--yes", action="store_true", help="turn torque off without asking")
+    p.add_argument("--reply-timeout-ms", type=float, metavar="MS", help=REPLY_TIMEOUT_HELP)
+    return p
 
 
 def run(args) -> int:
