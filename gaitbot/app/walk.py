@@ -23,6 +23,7 @@ from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
 from gaitbot.robot.gains import gain_notes, gain_writes
 from gaitbot.robot.walk_settings import joint_limits_ticks
 from gaitbot.sim import import_mujoco
+from gaitbot.sim.model3d import TorsoSupport
 from gaitbot.sim.video import check_video_path
 from gaitbot.stream.clock import MonotonicClock, VirtualClock
 from gaitbot.stream.health import HealthMonitor
@@ -167,8 +168,8 @@ def _report(args, config, walk: PlannedWalk, result, sim, port: str, clock, heal
     if sim is not None and args.json:
         return _sim_exit(_sim_report(sim, True, result.outcome, args.video), result.exit_code)
     if sim is not None:
-        torso = {"free": "free-floating torso", "boom": "torso on a boom, pitch held",
-                 "boom-pitch": "torso on a boom, free to pitch"}[sim.robot.support]
+        torso = {TorsoSupport.FREE: "free-floating torso", TorsoSupport.BOOM: "torso on a boom, pitch held",
+                 TorsoSupport.BOOM_PITCH: "torso on a boom, free to pitch"}[sim.robot.support]
         mode = (f"simulated robot (MuJoCo; {config.bus.backend} packets on a simulated bus, simulated clock; "
                 f"{torso})")
     elif not args.dry_run:
@@ -206,12 +207,12 @@ def _sim_exit(report, session_exit: int) -> int:
     return 1 if report.fell and session_exit == 0 else session_exit
 
 
-def sim_support(args, config) -> str:
+def sim_support(args, config) -> TorsoSupport:
     """How the simulated torso is held: free-floating unless --boom or --free-pitch asks for the boom (or the
     config says the robot walks on one, ``[robot] boom = true``)."""
     if args.free_pitch:
-        return "boom-pitch"
-    return "boom" if (args.boom or config.boom) else "free"
+        return TorsoSupport.BOOM_PITCH
+    return TorsoSupport.BOOM if (args.boom or config.boom) else TorsoSupport.FREE
 
 
 MAX_PUSH_NS = 20.0

@@ -733,3 +733,55 @@ def test_a_failing_close_is_reported_and_the_sigterm_handler_still_restored(clos
         signal.signal(signal.SIGTERM, previous)
     assert result.outcome == "completed" and bus.closed
     assert any("closing the bus" in note for note in result.notes)
+
+
+# --------------------------------------------------------------------------- WalkSession and frame sources
+
+def test_a_frame_source_is_pulled_one_frame_at_a_time_and_sends_what_the_array_sends():
+    """A live walk hands the session an iterator: each frame is taken only when it is due (after the frame
+    before it went out), and the writes, their times and the stop are those of the same frames as an array."""
+    from gaitbot.stream.session import SessionLimits, WalkSession
+
+    walk = gait_frames()
+    clock_a = VirtualClock(bus_call_cost_s=0.001)
+    bus_a = start_pose_bus(clock_a)
+    by_array = session(bus_a, clock_a, frames=walk)
+
+    clock_b = VirtualClock(bus_call_cost_s=0.001)
+    bus_b = start_pose_bus(clock_b)
+    writes_when_pulled = []
+
+    def frame_source():
+        for frame in walk:
+            writes_when_pulled.append(len(bus_b.writes))
+            yield frame.tolist()  # any row of ticks will do
+
+    live = WalkSession(bus_b, IDS, STAND, SessionLimits(VMAX, AMAX, PERIOD_S), clock=clock_b, torque_off_on_exit=True)
+    by_source = live.run(frame_source())
+    assert by_source.outcome == by_array.outcome == "completed" and by_source.exit_code == 0
+    assert [(t, g) for t, g in bus_b.writes] == [(t, g) for t, g in bus_a.writes]
+    assert by_source.walk_stats.frames == by_array.walk_stats.frames
+    # frame k (k >= 2) is pulled after frame k - 1 was written: never ahead of the stream
+    start = writes_when_pulled[1]
+    assert writes_when_pulled[1:] == list(range(start, start + len(walk) - 1))
+
+
+def test_a_frame_source_that_ends_early_still_ends_standing():
+    """A live walk that stops producing frames (its planner ended the walk anywhere) gets the final ramp."""
+    from gaitbot.stream.session import SessionLimits, WalkSession
+
+    clock = VirtualClock()
+    bus = start_pose_bus(clock)
+    result = WalkSession(bus, IDS, STAND, SessionLimits(VMAX, AMAX, PERIOD_S), clock=clock).run(iter(gait_frames()[:45]))
+    assert result.outcome == "completed" and result.reached_stand
+    np.testing.assert_array_equal(bus.write_ticks()[-1], STAND)
+
+
+def test_session_limits_are_one_record_and_outcomes_compare_as_their_names():
+    from gaitbot.stream.session import Outcome, SessionLimits
+
+    limits = SessionLimits(VMAX, AMAX, PERIOD_S)
+    ramp = limits.ramp(np.full(4, 1000), STAND)
+    np.testing.assert_array_equal(ramp, ramp_ticks(np.full(4, 1000), STAND, VMAX, AMAX, PERIOD_S))
+    assert Outcome.TERMINATED == "terminated" and {"terminated": 1}[Outcome.TERMINATED] == 1
+    assert [o.exit_code for o in Outcome] == [0, 128 + signal.SIGINT, 128 + signal.SIGTERM, 1, 1]
