@@ -1,7 +1,7 @@
-"""``python -m gaitbot``: the same as the ``gaitbot`` command."""
+"""``python -m gaitbot``: the same as the ``gaitbot`` command (gaitbot.app.entry)."""
 
 import sys
 
-from gaitbot.app.cli import main
+from gaitbot.app.entry import main
 
 sys.exit(main())

@@ -217,13 +217,13 @@ def other_robots_mm() -> tuple[float, float]:
     among robots that walk with the same joints (the planar ones, the 3D ones)."""
     from gaitbot.app.eigen import robot_legs
     from gaitbot.app.options import gait_source
-    from gaitbot.app.walks import trajectory_for_robot
+    from gaitbot.app.planned_walk import planned_walk
 
     walks, legs = {}, {}
     for name in ("xl430-biped", "sts3215-biped", "ax12a-biped", "op3", "bioloid"):
         args = argparse.Namespace(robot=name, steps="0.03,0.03,0.03,0.03", distance=None, max_step=None,
                                   perturb=None, seed=None, calibration=None)
-        _, _, walks[name] = trajectory_for_robot(args)
+        walks[name] = planned_walk(args).planned
         legs[name] = robot_legs(gait_source(args), load_robot(name))
     offsets = [1000 * legs[a].root_height_error_m(walks[b]) for a in walks for b in walks
                if a != b and legs[a].joints == tuple(walks[b].joints)]

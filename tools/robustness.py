@@ -6,7 +6,7 @@
     python tools/robustness.py --robot bioloid   # the same for the BIOLOID Type A (its own walks, no Menagerie)
 
 Every walk is planned once, from the shipped config/op3.toml, exactly as ``gaitbot generate`` plans it
-(gaitbot.app.walks), then played open loop, each frame's goals held 1/60 s, on:
+(gaitbot.app.planned_walk), then played open loop, each frame's goals held 1/60 s, on:
 - our model (gaitbot.sim, free-floating) with the servos at the gain gaitbot writes (6 deg) and the goals
   with sag feedforward, or at the factory gain (12.4 deg) with the plain planned angles;
 - our model built from a config whose masses, or every link's centre of mass distance from its joint
@@ -40,7 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import op3_menagerie  # noqa: E402
 
-from gaitbot.app.walks import trajectory_for_robot  # noqa: E402
+from gaitbot.app.planned_walk import planned_walk  # noqa: E402
 from gaitbot.robot.config import load_robot_config, resolve_config  # noqa: E402
 from gaitbot.sim import import_mujoco  # noqa: E402
 
@@ -106,8 +106,8 @@ def plan_arguments(args: list[str], robot: str = "op3") -> argparse.Namespace:
 
 
 def plan(args: list[str], robot: str = "op3"):
-    _, walker, planned = trajectory_for_robot(plan_arguments(args, robot=robot))
-    return walker, planned, walker.walk.trajectory(goals=True)
+    walk = planned_walk(plan_arguments(args, robot=robot))
+    return walk.plan, walk.planned, walk.goals
 
 
 def perturbed(config, kind: str):

@@ -63,12 +63,12 @@ def steered_args(robot: str, walk: list[str], commands_dir: str):
 
 def plan_walk(robot: str, name: str, commands_dir: str):
     """(plan, trajectory) of a named walk, as gaitbot generate plans it."""
-    from gaitbot.app.steer_walk import steered_walk
+    from gaitbot.app.planned_walk import planned_walk
 
     with open(os.path.join(commands_dir, "square.jsonl"), "w") as f:
         f.write(SQUARE)
-    _, plan, trajectory = steered_walk(steered_args(robot, WALKS[name], commands_dir))
-    return plan, trajectory
+    walk = planned_walk(steered_args(robot, WALKS[name], commands_dir))
+    return walk.plan, walk.planned
 
 
 def menagerie_sole_gap_m(trajectory) -> float:

@@ -33,7 +33,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from gaitbot.app.progress import progress  # noqa: E402
 from gaitbot.check.trajectory import check_trajectory  # noqa: E402
-from gaitbot.gait.segments import GaitGenerationError  # noqa: E402
+from gaitbot.gait.walk_segments import GaitGenerationError  # noqa: E402
 from gaitbot.gait.terrain.envelope import StepEnvelope  # noqa: E402
 from gaitbot.gait.terrain.footholds import CourseError  # noqa: E402
 from gaitbot.gait.terrain.model import Terrain, Tread  # noqa: E402

@@ -1,7 +1,7 @@
 """``gaitbot calibrate``: each joint's zero tick and direction measured on the robot, written to a calibration file.
 
 The person holds the robot (torque off) in its zero pose, then bends each joint in its positive direction
-when asked (gaitbot/stream/calibrate.py runs the steps; gaitbot/robot/joint_words.py says them in words).
+when asked (gaitbot/stream/calibrate.py runs the steps; gaitbot/robot/joint_directions.py says them in words).
 The file (gaitbot/robot/calibration_file.py, docs/file-formats.md) is checked against the config before it
 is written: a zero tick with which a configured limit falls outside the servo's range is refused with the
 range. Nothing is written to a servo but Torque Enable = 0.
@@ -13,12 +13,13 @@ import os
 import sys
 from pathlib import Path
 
+from gaitbot.app.arguments import REPLY_TIMEOUT_HELP, add_command
 from gaitbot.app.hardware import serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
 from gaitbot.bus.factory import make_robot_bus
 from gaitbot.robot.calibration_file import (CalibrationFile, JointCalibration, apply_calibration,
                                             calibration_path_for, write_calibration)
-from gaitbot.robot.joint_words import positive_motion
+from gaitbot.robot.joint_directions import positive_motion
 from gaitbot.stream.calibrate import CalibrationJoint, CalibrationStopped, calibrate_session
 
 ZERO_POSE = ("Hold the robot in its zero pose: legs straight, feet flat and parallel, torso upright "
@@ -53,6 +54,16 @@ def _confirm(yes: bool):
             print()
         return answer.strip().lower() in ("y", "yes")
     return confirm
+
+
+def add_parser(subparsers):
+    p = add_command(subparsers, "calibrate")
+    p.add_argument("--robot", help="robot config (default xl430-biped)")
+    p.add_argument("-o", "--output", required=True, help="calibration file to write (.toml)")
+    p.add_argument("--port", help="serial port (default: the robot config's)")
+    p.add_argument("--yes", action="store_true", help="turn torque off without asking")
+    p.add_argument("--reply-timeout-ms", type=float, metavar="MS", help=REPLY_TIMEOUT_HELP)
+    return p
 
 
 def run(args) -> int:

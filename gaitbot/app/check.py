@@ -14,11 +14,26 @@ import json
 import math
 from pathlib import Path
 
+from gaitbot.app.arguments import add_command, robot_options
 from gaitbot.app.options import UsageError, load_robot
 from gaitbot.bus.log import is_bus_log
 from gaitbot.check.preflight import preflight
 from gaitbot.check.recording import check_recording, robot_for_recording
 from gaitbot.gait.trajectory import load_fast, refuse_truncated_csv
+
+
+def add_parser(subparsers):
+    p = add_command(subparsers, "check")
+    p.add_argument("file", help="trajectory (.csv, .npz) or bus recording (.jsonl)")
+    robot_options(p, "robot config (default: a recording's own robot, else xl430-biped)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.add_argument("--margin-deg", type=float, default=0.0, metavar="DEG",
+                   help="warn within this many degrees of a limit (default 0)")
+    p.add_argument("--boom", action="store_true",
+                   help="the robot walks on a boom: do not check its balance (ZMP against the support polygon)")
+    p.add_argument("--allow-partial", action="store_true",
+                   help="recordings: ignore a truncated last line (with a warning), e.g. after a crash")
+    return p
 
 
 def run(args) -> int:

@@ -29,13 +29,14 @@ from pathlib import Path
 
 import numpy as np
 
+from gaitbot.app.arguments import add_command, leg_options, robot_options
 from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, PlanarLegs, SpatialLegs, WalkEnds,
                                 cycles_from_trajectory, fit_model, synthesize_walk, walk_label)
 from gaitbot.gait.footfall import CONTACT_TOL_FRACTION
 from gaitbot.gait.trajectory import MAX_ANGLE_DEG, Trajectory
 from gaitbot.app.options import UsageError, check_output_path, gait_source, load_robot, write_output
 from gaitbot.app.progress import callback, progress
-from gaitbot.app.walks import balanced_plan
+from gaitbot.app.planned_walk import balanced_plan
 from gaitbot.check.preflight import preflight
 from gaitbot.errors import UserError
 from gaitbot.robot.config import shipped_config_names
@@ -44,6 +45,53 @@ from gaitbot.robot.walk_settings import GaitSource, walk_settings
 POSE_TOL_DEG = 0.1
 #: Synthesised cycles one `eigen synth` may ask for (each two steps).
 MAX_CYCLES = 500
+
+
+def add_parser(subparsers):
+    """``eigen`` and its own subcommands ``eigen fit`` and ``eigen synth`` (``parser.commands``)."""
+    p = add_command(subparsers, "eigen")
+    eigen = p.add_subparsers(dest="eigen_command", required=True, metavar="{fit,synth}")
+    q = add_command(eigen, "eigen fit")
+    q.add_argument("examples", nargs="+", help="trajectory files (.npz or .csv), one walk each")
+    q.add_argument("-o", "--output", required=True, help="model file, e.g. model.npz")
+    robot_options(q, "robot config whose leg walked the examples (default xl430-biped); the model remembers it")
+    leg_options(q, "when the examples were walked with another leg than the robot's; the model remembers it")
+    q.add_argument("--samples", type=int, default=100, help="samples per resampled cycle (default 100)")
+    q.add_argument("--basis", choices=("fourier", "bspline"), default="fourier",
+                   help="functions the cycles are fitted with: fourier for periodic walking (default), bspline for "
+                   "motion that does not repeat")
+    q.add_argument("--n-basis", type=int, default=31, help="basis functions per channel (odd for fourier; default 31)")
+    q.add_argument("--roughness", type=float, default=0.0,
+                   help="penalty on the fitted curves' second derivative: larger is smoother (default 0)")
+    q.add_argument("--pose-variance", type=float, default=0.95, metavar="SHARE",
+                   help="share of the pose variance the pose PCA keeps at least (default 0.95)")
+    q.add_argument("--pose-tolerance-deg", type=float, default=0.5, metavar="DEG",
+                   help="and more pose axes until no example pose moves by more than this when projected "
+                   "(default 0.5; inf: the variance rule alone)")
+    q.add_argument("--variance", type=float, default=0.95, metavar="SHARE",
+                   help="share of the variance the eigen-motions kept explain (default 0.95)")
+    q.add_argument("--components", type=int, metavar="N", help="keep exactly this many eigen-motions")
+    q.add_argument("--align", choices=("dtw", "none"), default="dtw",
+                   help="time alignment of the cycles: dynamic time warping (default) or none")
+    q.add_argument("--label-degree", type=int, default=2, metavar="N",
+                   help="degree of the polynomial that maps step length to the model's coefficients (default 2)")
+    r = add_command(eigen, "eigen synth")
+    r.add_argument("model", help="model file from gaitbot eigen fit")
+    r.add_argument("--step-length", type=float, required=True, metavar="M", help="step length in metres")
+    r.add_argument("--to-step-length", type=float, metavar="M",
+                   help="change the step length smoothly to this over the cycles")
+    r.add_argument("--cycles", type=int, default=3, help="synthesised cycles (two steps each; default 3)")
+    r.add_argument("--components", type=int, metavar="N", help="eigen-motions to use (default: those the model kept)")
+    r.add_argument("--pose-deg", metavar="DEG,DEG,...",
+                   help="the pose the motion must pass through: one angle in degrees per joint of the model, in its "
+                   "order (eigen fit prints it; six pitch joints: hip, knee, ankle left, then right); write "
+                   "--pose-deg=-5,... when the first is negative")
+    r.add_argument("--pose-time", type=float, metavar="S", help="seconds into each synthesised cycle for --pose-deg")
+    robot_options(r, "robot config (default: the robot the model was fitted for)")
+    leg_options(r, "must be the leg the model was fitted with")
+    r.add_argument("-o", "--output", required=True, help="walk.csv or walk.npz")
+    p.commands = {"eigen fit": q, "eigen synth": r}
+    return p
 
 
 def run(args) -> int:
@@ -277,6 +325,34 @@ def walk_ends(config, source: GaitSource):
     return WalkEnds(lambda step_m, n: balanced_plan(source, [step_m] * n).walk.trajectory(), steps, join_order=2)
 
 
+def _forced_pose(args, model, config, components):
+    """``--pose-deg`` at ``--pose-time``: the eigen-motions' weights that take every cycle through the pose
+    (one per cycle, and one for the walk's end) and (the pose time, the worst joint's miss in deg); (None,
+    None) without --pose-deg."""
+    if args.pose_deg is None:
+        return None, None
+    if args.pose_time is None:
+        raise UsageError("--pose-deg needs --pose-time (seconds into each synthesised cycle)")
+    if args.to_step_length is not None:
+        raise UsageError("--pose-deg forces every cycle through one pose: leave out --to-step-length")
+    pose_deg = _parse_pose(args.pose_deg, model.joints)
+    _check_pose_limits(config, model.joints, pose_deg)
+    duration, warp, _ = model.timing_for(args.step_length)
+    if not (0.0 <= args.pose_time < duration):
+        raise UsageError(f"--pose-time must be from 0 to below the cycle's {duration:.4g} s, got {args.pose_time:g}")
+    s_prime = float(model.aligned_phase(args.pose_time / duration, warp))
+    alpha, miss = model.through_pose(np.radians(pose_deg), s_prime, model.coefficients_for(args.step_length, components))
+    worst = float(np.degrees(np.abs(miss)).max())
+    if worst > POSE_TOL_DEG:
+        j = int(np.argmax(np.abs(miss)))
+        hint = f"try --components up to {len(model.eigenvalues)}"
+        if model.pose_dims < len(model.joints):
+            hint += ", or fit with a smaller --pose-tolerance-deg (more pose axes)"
+        raise EigenModelError(f"--pose-deg cannot be reached: the model's {len(alpha)} eigen-motions and "
+                              f"{model.pose_dims} pose axes miss {model.joints[j]} by {worst:.3g} deg ({hint})")
+    return [alpha] * (args.cycles + 1), (args.pose_time, worst)
+
+
 def run_synth(args) -> int:
     out = Path(args.output)
     if out.suffix not in (".csv", ".npz"):
@@ -305,30 +381,7 @@ def run_synth(args) -> int:
     if components is not None and not (1 <= components <= len(model.eigenvalues)):
         raise UsageError(f"--components {components}: the model has {len(model.eigenvalues)} eigen-motions "
                          f"(fit with more example walks for more)")
-    alphas = None
-    pose_report = None
-    if args.pose_deg is not None:
-        if args.pose_time is None:
-            raise UsageError("--pose-deg needs --pose-time (seconds into each synthesised cycle)")
-        if args.to_step_length is not None:
-            raise UsageError("--pose-deg forces every cycle through one pose: leave out --to-step-length")
-        pose_deg = _parse_pose(args.pose_deg, model.joints)
-        _check_pose_limits(config, model.joints, pose_deg)
-        duration, warp, _ = model.timing_for(args.step_length)
-        if not (0.0 <= args.pose_time < duration):
-            raise UsageError(f"--pose-time must be from 0 to below the cycle's {duration:.4g} s, got {args.pose_time:g}")
-        s_prime = float(model.aligned_phase(args.pose_time / duration, warp))
-        alpha, miss = model.through_pose(np.radians(pose_deg), s_prime, model.coefficients_for(args.step_length, components))
-        worst = float(np.degrees(np.abs(miss)).max())
-        if worst > POSE_TOL_DEG:
-            j = int(np.argmax(np.abs(miss)))
-            hint = f"try --components up to {len(model.eigenvalues)}"
-            if model.pose_dims < len(model.joints):
-                hint += ", or fit with a smaller --pose-tolerance-deg (more pose axes)"
-            raise EigenModelError(f"--pose-deg cannot be reached: the model's {len(alpha)} eigen-motions and "
-                                  f"{model.pose_dims} pose axes miss {model.joints[j]} by {worst:.3g} deg ({hint})")
-        alphas = [alpha] * (args.cycles + 1)
-        pose_report = (args.pose_time, worst)
+    alphas, pose_report = _forced_pose(args, model, config, components)
     try:
         walk = synthesize_walk(model, settings, args.step_length, args.to_step_length, cycles=args.cycles,
                                components=components, alphas=alphas, ends=walk_ends(config, source), legs=legs)

@@ -9,8 +9,22 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from gaitbot.app.arguments import add_command, check_walk_source, walk_options
 from gaitbot.app.options import UsageError, check_output_path, walked_by, write_output
-from gaitbot.app.walks import trajectory_for_robot
+from gaitbot.app.planned_walk import planned_walk
+
+
+def add_parser(subparsers):
+    p = add_command(subparsers, "generate")
+    walk_options(p)
+    p.add_argument("-o", "--output", required=True, help="walk.csv or walk.npz (file formats: docs/file-formats.md)")
+    p.add_argument("--goals", action="store_true", help="write the goal angles a walk sends (servo-sag "
+                   "feedforward included) instead of the planned angles")
+    return p
+
+
+def check_arguments(parser, args) -> None:
+    check_walk_source(parser, args)
 
 
 def run(args) -> int:
@@ -18,8 +32,9 @@ def run(args) -> int:
     if out.suffix not in (".csv", ".npz"):
         raise UsageError(f"-o {out}: the output must end in .csv or .npz")
     check_output_path(out)
-    source, walker, trajectory = trajectory_for_robot(args, goals=getattr(args, "goals", False))
+    walk = planned_walk(args)
+    trajectory = walk.goals if getattr(args, "goals", False) else walk.planned
     write_output(out, trajectory.save)
-    print(f"wrote {out} for {walked_by(source)}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
-          f"{len(walker.heel_strikes)} heel strikes, {trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.4f} m")
+    print(f"wrote {out} for {walked_by(walk.source)}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
+          f"{len(walk.heel_strikes)} heel strikes, {trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.4f} m")
     return 0

@@ -15,7 +15,7 @@ from gaitbot.bus.budget import bus_budget_check, check_robot_rate
 from gaitbot.errors import UserError
 from gaitbot.gait.geometry import LegGeometry
 from gaitbot.gait.planning import perturb_steps, steps_for_distance
-from gaitbot.gait.walker import WalkSettings, make_context
+from gaitbot.gait.walker import WalkSettings, longest_step_m
 from gaitbot.robot.calibration_file import load_robot_with_calibration
 from gaitbot.robot.config import RATE_RANGE_HZ, ConfigError, RobotConfig
 from gaitbot.robot.walk_settings import GaitSource, leg_geometry, walk_settings
@@ -103,9 +103,11 @@ def check_rate_range(rate_hz: float, label: str = "--rate") -> None:
         raise UsageError(f"{label} must be a frame rate within {low:g}..{high:g} Hz, got {rate_hz:g}")
 
 
-def gait_source(args) -> GaitSource:
-    """Geometry and settings from ``--robot`` (or the default robot), with ``--thigh/--shank/--foot`` overrides."""
-    robot = load_robot(getattr(args, "robot", None), getattr(args, "calibration", None))
+def gait_source(args, robot: RobotConfig | None = None) -> GaitSource:
+    """Geometry and settings from ``robot`` (else ``--robot``, or the default robot, loaded here), with the
+    ``--thigh/--shank/--foot``, ``--rate``, ``--cycle`` and ``--clearance`` overrides."""
+    if robot is None:
+        robot = load_robot(getattr(args, "robot", None), getattr(args, "calibration", None))
     geometry = leg_geometry(robot)
     overrides = {k: getattr(args, k, None) for k in ("thigh", "shank", "foot")}
     if any(v is not None for v in overrides.values()):
@@ -132,7 +134,7 @@ def gait_source(args) -> GaitSource:
         if not (math.isfinite(clearance) and clearance >= 0):
             raise UsageError(f"--clearance must be 0 or more metres, got {clearance!r}")
         settings = WalkSettings(settings.cycle_s, settings.rate_hz, clearance)
-    reachable = make_context(geometry, settings).inverse.max_step_length
+    reachable = longest_step_m(geometry, settings)
     max_step = robot.gait.max_step_m if robot_for_limits is not None else reachable
     if robot_for_limits is not None and robot.is_3d:  # its max_step_m is the default; the leg's reach the limit
         return GaitSource(geometry, settings, reachable, robot, default_step_m=min(max_step, reachable))

@@ -5,23 +5,37 @@ from __future__ import annotations
 import json
 import math
 
+from gaitbot.app.arguments import add_command, check_walk_source, walk_options
 from gaitbot.app.options import walked_by
+from gaitbot.app.planned_walk import planned_walk
 from gaitbot.app.steer_options import steer_requested
-from gaitbot.app.steer_walk import print_steered_plan, steered_plan_summary
-from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.gait.walker import OnlineWalker
 from gaitbot.robot.walk_settings import GaitSource
 
 
+def add_parser(subparsers):
+    p = add_command(subparsers, "plan")
+    walk_options(p)
+    p.add_argument("--json", action="store_true", help="print the plan as one JSON object")
+    return p
+
+
+def check_arguments(parser, args) -> None:
+    check_walk_source(parser, args)
+
+
 def run(args) -> int:
+    walk = planned_walk(args)
     if getattr(args, "terrain", None) is not None:
-        return _plan_terrain(args)
-    source, walker, _ = trajectory_for_robot(args)
+        return _plan_terrain(args, walk)
+    source = walk.source
     if steer_requested(args):
-        summary = steered_plan_summary(source, walker)
+        from gaitbot.app.steer_walk import print_steered_plan, steered_plan_summary
+
+        summary = steered_plan_summary(source, walk.plan)
         print(json.dumps(summary, indent=2)) if args.json else print_steered_plan(summary)
         return 0
-    plan = balanced_plan_summary(source, walker) if source.balanced else plan_summary(source, walker)
+    plan = balanced_plan_summary(source, walk.plan) if source.balanced else plan_summary(source, walk.plan)
     if args.json:
         print(json.dumps(plan, indent=2))
         return 0
@@ -38,9 +52,9 @@ def run(args) -> int:
     return 0
 
 
-def _plan_terrain(args) -> int:
-    source, walk, _ = trajectory_for_robot(args)
-    plan = terrain_plan_summary(source, walk)
+def _plan_terrain(args, walk) -> int:
+    source = walk.source
+    plan = terrain_plan_summary(source, walk.plan)
     if args.json:
         print(json.dumps(plan, indent=2))
         return 0

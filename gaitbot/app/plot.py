@@ -4,11 +4,26 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from gaitbot.app.arguments import add_command, leg_options, robot_options
 from gaitbot.app.options import UsageError, check_output_path, file_option, gait_source, walked_by, write_output
 from gaitbot.errors import UserError
 from gaitbot.gait.eigen import is_model_file
 from gaitbot.gait.terrain.course_file import load_course
 from gaitbot.gait.trajectory import Trajectory
+
+
+def add_parser(subparsers):
+    p = add_command(subparsers, "plot")
+    p.add_argument("file", help="trajectory (.csv or .npz), or an eigen-gait model (.npz from gaitbot eigen fit)")
+    p.add_argument("-o", "--output", required=True, help="picture file, e.g. walk.png (or .svg, .pdf)")
+    robot_options(p, "robot config whose leg walked the trajectory (default xl430-biped)")
+    p.add_argument("--commands", metavar="FILE", help="a steered walk's commands (JSON Lines), drawn over time")
+    leg_options(p, "if the trajectory was made with another leg")
+    p.add_argument("--clearance", type=float, metavar="M",
+                   help="clearance line drawn on the foot heights, metres (default: the robot's clearance_m)")
+    p.add_argument("--terrain", metavar="FILE", help="terrain course the trajectory walked: draw it, and foot heights "
+                   "above it")
+    return p
 
 
 def run(args) -> int:

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gaitbot.app.arguments import add_command, bus_options, robot_options
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
 from gaitbot.bus.factory import make_robot_bus
@@ -153,6 +154,18 @@ def _status_line(rate_hz: float):
             sys.stderr.flush()
 
     return show
+
+
+def add_parser(subparsers):
+    p = add_command(subparsers, "record")
+    robot_options(p, "robot config: a .toml path or a shipped name (default xl430-biped)")
+    p.add_argument("-o", "--output", required=True, help="trajectory CSV, written as it is read, e.g. demo.csv")
+    p.add_argument("--duration", type=float, metavar="S", help="seconds to record (default: until Ctrl-C)")
+    p.add_argument("--yes", action="store_true", help="turn torque off without asking")
+    p.add_argument("--hold", action="store_true", help="at the end, hold the last pose (torque on) instead of "
+                   "leaving torque off")
+    bus_options(p, "record from the mock bus (needs --duration)")
+    return p
 
 
 def run(args) -> int:

@@ -13,10 +13,13 @@ import math
 import sys
 from pathlib import Path
 
+from gaitbot.app.arguments import add_command
 
-def add_parser(sub, command) -> dict[str, argparse.ArgumentParser]:
-    """The ``robot`` command and its two sub-commands on ``sub`` (argparse subparsers); ``command(sub, name)``
-    makes a parser with gaitbot's help texts (gaitbot.app.help). Returns the parsers by command name."""
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    """The ``robot`` command and its two sub-commands on ``sub`` (argparse subparsers); ``p.commands`` holds the
+    sub-commands' parsers by name (their errors print their own usage)."""
+    command = add_command
     p = command(sub, "robot")
     robot = p.add_subparsers(dest="robot_command", required=True, metavar="{export,import}",
                              help="export a config to URDF/MJCF, or import a URDF/MJCF as a config draft")
@@ -31,7 +34,8 @@ def add_parser(sub, command) -> dict[str, argparse.ArgumentParser]:
                    "gait settings from this config, by joint name (default: placeholders, marked as a draft)")
     i.add_argument("--map", metavar="FILE", help="which description joint is which gaitbot joint, when the names do "
                    "not say: a [joints] table, gaitbot joint = \"description joint\" (a leading - flips the sign)")
-    return {"robot": p, "robot export": e, "robot import": i}
+    p.commands = {"robot export": e, "robot import": i}
+    return p
 
 
 def run(args) -> int:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import math
 
+from gaitbot.app.arguments import add_command, bus_options, robot_options
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
 from gaitbot.bus.bringup import ServoReport, describe_servo, survey
@@ -53,6 +54,16 @@ def _missing(config, rows: list[dict]) -> list[dict]:
 
 def _text(value, fmt: str = "{}") -> str:
     return "-" if value is None else fmt.format(value)
+
+
+def add_parser(subparsers):
+    p = add_command(subparsers, "scan")
+    robot_options(p, "robot config: its protocol, and the joints to match (default xl430-biped)")
+    p.add_argument("--baud", type=int, help="scan this baud rate only (default: every rate a servo of the "
+                   "configured protocol can run at)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    bus_options(p, "scan the mock bus (the config's servos at its baud rate)")
+    return p
 
 
 def run(args) -> int:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import sys
 
+from gaitbot.app.arguments import REPLY_TIMEOUT_HELP, add_command, robot_options
 from gaitbot.app.hardware import serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
 from gaitbot.bus.base import BusError
@@ -38,6 +39,18 @@ def selected_joints(config, names: list[str] | None):
     if unknown:
         raise UsageError(f"--joint {unknown[0]}: no such joint in {config.path} (joints: {', '.join(known)})")
     return [known[n] for n in dict.fromkeys(names)]
+
+
+def add_parser(subparsers):
+    p = add_command(subparsers, "setup")
+    robot_options(p, "robot config: the ids, models and baud rate to give (default xl430-biped)")
+    p.add_argument("--joint", action="append", metavar="NAME", help="set up this joint only (repeat for several; "
+                   "default: every joint, in the config's order)")
+    p.add_argument("--port", help="serial port (default: the robot config's)")
+    p.add_argument("--yes", action="store_true", help="do not wait for Enter: the servo is already connected")
+    p.add_argument("--reply-timeout-ms", type=float, metavar="MS", help=REPLY_TIMEOUT_HELP + "; a short one (5) "
+                   "speeds up the search, which tries every id at every baud rate")
+    return p
 
 
 def run(args) -> int:

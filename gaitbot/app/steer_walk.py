@@ -1,6 +1,6 @@
 """The gait source of a steered walk (``--velocity``/``--duration``, ``--commands``: gaitbot.app.steer_options):
 the command schedule, the planned walk, and the plan's summary for ``gaitbot plan`` (docs/steering.md).
-``steered_walk`` returns the same triple as gaitbot.app.walks.trajectory_for_robot.
+``steered_plan`` is the steered gait source of gaitbot.app.planned_walk.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gaitbot.app.options import MAX_STEPS, UsageError, file_option, gait_source
+from gaitbot.app.options import MAX_STEPS, UsageError, file_option
 from gaitbot.app.steer_options import steer_sources
 from gaitbot.gait.steer.command import CommandError, parse_velocity, read_commands
 from gaitbot.gait.steer.planner import Footstep
@@ -57,9 +57,8 @@ class SteeredPlan(BalancedPlan):
     schedule: CommandSchedule | None = None
 
 
-def steered_walk(args, goals: bool = False):
-    """(source, plan, trajectory) of a steered walk, as trajectory_for_robot returns for straight ones."""
-    source = gait_source(args)
+def steered_plan(source, args) -> "SteeredPlan":
+    """The steered walk of the options (``--velocity``, ``--commands``) for the loaded robot (``source``)."""
     if not source.balanced:
         name = source.robot.name if source.robot is not None else "this leg"
         raise UsageError(f"--{steer_sources(args)[0]}: {name} walks with the planar walker, which walks straight; "
@@ -72,8 +71,7 @@ def steered_walk(args, goals: bool = False):
         plan, steps = plan_steered(source.robot, schedule, gait, MAX_STEPS)
     except CommandError as exc:
         raise UsageError(str(exc)) from None
-    steered = SteeredPlan(plan.walk, plan.fit, plan.walker, tuple(steps), schedule)
-    return source, steered, plan.walk.trajectory(goals=goals)
+    return SteeredPlan(plan.walk, plan.fit, plan.walker, tuple(steps), schedule)
 
 
 def commanded_pose(schedule: CommandSchedule) -> tuple[float, float, float]:

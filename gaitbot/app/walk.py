@@ -1,7 +1,8 @@
 """``gaitbot walk``: a walk streamed to the robot, the mock bus (``--dry-run``) or the simulated robot (``--sim``).
 
-The preflight check first (nothing moves if any frame breaks a limit), then the walk session on a
-bus behind the LimitGuard; docs/bus-faults.md says what happens when the bus fails.
+The robot loaded once, the walk planned once (gaitbot.app.planned_walk), the preflight check (nothing
+moves if any frame breaks a limit), then the walk session (gaitbot.stream.session.WalkSession) on a bus
+behind the LimitGuard; docs/bus-faults.md says what happens when the bus fails.
 """
 
 from __future__ import annotations
@@ -9,11 +10,12 @@ from __future__ import annotations
 import math
 import sys
 
+from gaitbot.app.arguments import add_command, bus_options, check_walk_source, walk_options
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
+from gaitbot.app.planned_walk import PlannedWalk, planned_walk
 from gaitbot.app.progress import callback, progress
-from gaitbot.app.view_options import open_view
-from gaitbot.app.walks import trajectory_for_robot
+from gaitbot.app.view_options import add_view_options, open_view
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.log import BusRecorder, RecordingFailed
 from gaitbot.check.preflight import preflight
@@ -22,10 +24,11 @@ from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
 from gaitbot.robot.gains import gain_notes, gain_writes
 from gaitbot.robot.walk_settings import joint_limits_ticks
 from gaitbot.sim import import_mujoco
+from gaitbot.sim.model3d import TorsoSupport
 from gaitbot.sim.video import check_video_path
 from gaitbot.stream.clock import MonotonicClock, VirtualClock
 from gaitbot.stream.health import HealthMonitor
-from gaitbot.stream.session import walk_session
+from gaitbot.stream.session import SessionLimits, WalkSession
 
 
 class LimitBroken(UserError):
@@ -59,71 +62,78 @@ def _warn_line(text: str) -> None:
     print(f"{prefix}warning: {text}", file=sys.stderr, flush=True)
 
 
+def add_parser(subparsers):
+    p = add_command(subparsers, "walk")
+    walk_options(p, demo=True)
+    p.add_argument("--trajectory", metavar="FILE", help="walk a trajectory file (.csv/.npz: gaitbot generate, "
+                   "eigen synth, record) instead of --steps/--distance; it streams at its own frame rate")
+    bus_options(p, "use the mock bus under the real SDK: no hardware, and every packet exactly as a real walk sends it")
+    p.add_argument("--realtime", action="store_true",
+                   help="--dry-run: pace it at the real frame rate (default: a simulated clock, as fast as it goes)")
+    p.add_argument("--record", metavar="FILE", help="write every bus packet to this .jsonl file (gaitbot check reads it)")
+    p.add_argument("--sim", action="store_true",
+                   help="walk the simulated robot (MuJoCo) and measure whether it really walks")
+    p.add_argument("--boom", action="store_true",
+                   help="the robot walks on a boom: accept a walk that would tip a free-standing robot (with --sim: "
+                   "the simulated torso rides a boom, sliding forward and up, pitch held)")
+    p.add_argument("--free-pitch", action="store_true", help="--sim: the boom, with the torso free to pitch on it")
+    p.add_argument("--push", type=float, metavar="N_S", help="--sim: push the torso sideways with this impulse "
+                   "(N s, positive to the left) in the middle of a step half-way through the walk")
+    p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (three-quarter view)")
+    p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
+    add_view_options(p)  # --mcap, --foxglove (gaitbot.app.view_options)
+    return p
+
+
+def check_arguments(parser, args) -> None:
+    """One source of steps; on the mock bus or the simulated robot none walks the demo."""
+    check_walk_source(parser, args, demo=args.dry_run or args.sim)
+
+
 def run(args) -> int:
     check_sim_arguments(args)
     refuse_port_in_dry_run(args)
     check_reply_timeout(args.reply_timeout_ms)
     config = load_robot(args.robot, getattr(args, "calibration", None))
     check_rate_option(config, args.rate)
-    args.robot = str(config.path)
-    source, walker, trajectory = trajectory_for_robot(args, goals=True)  # what the servos are sent
-    planned = walker.walk.trajectory() if hasattr(walker, "walk") else trajectory  # what the body does
-    report = preflight(config, trajectory, on_boom=args.boom, planned=planned)
+    walk = planned_walk(args, config)
+    report = preflight(config, walk.goals, on_boom=args.boom, planned=walk.planned)
     if not report.ok:
         raise LimitBroken(f"walk refused before anything moved: {report.first_error}")
-    frames = trajectory_ticks(config, trajectory)
-    straight = [name for name in config.walking_joint_names if name not in trajectory.joints]
+    frames = trajectory_ticks(config, walk.goals)
+    straight = [name for name in config.walking_joint_names if name not in walk.goals.joints]
     if straight:
         print(f"note: the trajectory does not move {', '.join(straight)}: held at 0 deg (straight)", file=sys.stderr)
-    period = 1.0 / source.settings.rate_hz
     sim = None
     if args.sim:
         from gaitbot.sim.walk import SimWalk, walk_plan  # MuJoCo: only with --sim
 
-        sim = SimWalk(config, source.settings.rate_hz, walk_plan(walker, planned), sim_support(args, config),
+        sim = SimWalk(config, walk.rate_hz, walk_plan(walk.plan, walk.planned), sim_support(args, config),
                       args.video, args.push)
     hardware = not (args.dry_run or args.sim)
     port = serial_port(config, args.port, dry_run=not hardware)
     clock = MonotonicClock() if (hardware or args.realtime) else VirtualClock()
     if hardware:
         warn_about_latency(port)
-    recorder = None
-    if args.record is not None:
-        file_option(args.record, "--record")
-        joints = {j.name: j.id for j in config.joints}
-        recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now,
-                               rate_hz=source.settings.rate_hz)
-    try:  # the recording's header is written here, before anything is sent
-        if sim is not None:
-            bus = guarded(config, sim.make_bus(clock.now, recorder))
-        else:
-            bus = make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,
-                                 reply_timeout_ms=args.reply_timeout_ms)
-    except (OSError, RecordingFailed) as exc:
-        if recorder is None:
-            raise
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
-        if isinstance(exc, RecordingFailed) and isinstance(exc.__cause__, OSError):
-            reason = exc.__cause__.strerror or exc.__cause__
-        raise UsageError(f"--record {args.record}: cannot write the recording ({reason}); nothing was sent") from None
+    recorder = _recorder(args, config, clock, walk.rate_hz)
+    bus = _open_bus(args, config, port, sim, clock, recorder)
     if getattr(args, "demo", False):  # said once every input was found good: a refusal stays one line (exit 2)
         print(f"note: no --steps, --distance, --terrain or --trajectory: walking the demo, --distance "
               f"{args.distance:g}", file=sys.stderr)
-    velocity, acceleration = joint_limits_ticks(config)
     for note in gain_notes(config):
         print(f"note: {note}", file=sys.stderr)
     health = HealthMonitor.for_robot(config, _warn_line, clock.now)
-    what = "simulating" if sim is not None else "walking"
+    velocity, acceleration = joint_limits_ticks(config)
+    session = WalkSession(bus, config.ids, standing_ticks(config),
+                          SessionLimits(velocity, acceleration, 1.0 / walk.rate_hz), clock=clock,
+                          torque_off_on_exit=config.bus.torque_off_on_exit, setup_writes=gain_writes(config),
+                          health=health)
     view = None
     try:
-        view = open_view(args, config, trajectory, planned, health, not isinstance(clock, VirtualClock))
-        with progress(what, total=len(frames), unit="frame") as bar:
-            status = _status(bar, walker.heel_strikes, source.settings.rate_hz, health)
-            result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
-                                  max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
-                                  torque_off_on_exit=config.bus.torque_off_on_exit,
-                                  on_frame=view.chain(status) if view else status,
-                                  setup_writes=gain_writes(config), health=health)
+        view = open_view(args, config, walk.goals, walk.planned, health, not isinstance(clock, VirtualClock))
+        with progress("simulating" if sim is not None else "walking", total=len(frames), unit="frame") as bar:
+            status = _status(bar, walk.heel_strikes, walk.rate_hz, health)
+            result = session.run(frames, view.chain(status) if view else status)
     finally:
         if recorder is not None:
             recorder.close()
@@ -131,11 +141,42 @@ def run(args) -> int:
             view.close()
     for note in getattr(bus, "open_notes", []):
         print(f"note: {note}", file=sys.stderr)
+    return _report(args, config, walk, result, sim, port, clock, health)
+
+
+def _recorder(args, config, clock, rate_hz: float) -> BusRecorder | None:
+    """The ``--record`` file's writer (its header is written when the bus opens), if asked."""
+    if args.record is None:
+        return None
+    file_option(args.record, "--record")
+    joints = {j.name: j.id for j in config.joints}
+    return BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now, rate_hz=rate_hz)
+
+
+def _open_bus(args, config, port: str, sim, clock, recorder: BusRecorder | None):
+    """The robot's bus behind its guard: the simulated robot's, the mock's or the serial port's. A recording
+    that cannot be written is refused here, before anything is sent."""
+    try:  # the recording's header is written here, before anything is sent
+        if sim is not None:
+            return guarded(config, sim.make_bus(clock.now, recorder))
+        return make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,
+                              reply_timeout_ms=args.reply_timeout_ms)
+    except (OSError, RecordingFailed) as exc:
+        if recorder is None:
+            raise
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        if isinstance(exc, RecordingFailed) and isinstance(exc.__cause__, OSError):
+            reason = exc.__cause__.strerror or exc.__cause__
+        raise UsageError(f"--record {args.record}: cannot write the recording ({reason}); nothing was sent") from None
+
+
+def _report(args, config, walk: PlannedWalk, result, sim, port: str, clock, health: HealthMonitor) -> int:
+    """What the walk did, on stdout (or the simulation's measurements as JSON), and the exit status."""
     if sim is not None and args.json:
         return _sim_exit(_sim_report(sim, True, result.outcome, args.video), result.exit_code)
     if sim is not None:
-        torso = {"free": "free-floating torso", "boom": "torso on a boom, pitch held",
-                 "boom-pitch": "torso on a boom, free to pitch"}[sim.robot.support]
+        torso = {TorsoSupport.FREE: "free-floating torso", TorsoSupport.BOOM: "torso on a boom, pitch held",
+                 TorsoSupport.BOOM_PITCH: "torso on a boom, free to pitch"}[sim.robot.support]
         mode = (f"simulated robot (MuJoCo; {config.bus.backend} packets on a simulated bus, simulated clock; "
                 f"{torso})")
     elif not args.dry_run:
@@ -146,8 +187,9 @@ def run(args) -> int:
         mode = "dry run (mock bus, simulated clock; --realtime paces it)"
     if config.calibration_file is not None:
         print(f"note: calibration {config.calibration_file} applied", file=sys.stderr)
-    print(f"{config.name}: {mode}: {len(walker.planned_steps)} heel strikes, "
-          f"{trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.3f} m planned. {result.message()}")
+    root = walk.goals.root_m
+    print(f"{config.name}: {mode}: {len(walk.planned_steps)} heel strikes, "
+          f"{root[-1, 0] - root[0, 0]:.3f} m planned. {result.message()}")
     if result.walk_stats is not None:
         print(result.walk_stats.summary(simulated_clock=isinstance(clock, VirtualClock)))
     if health.summary():
@@ -172,12 +214,12 @@ def _sim_exit(report, session_exit: int) -> int:
     return 1 if report.fell and session_exit == 0 else session_exit
 
 
-def sim_support(args, config) -> str:
+def sim_support(args, config) -> TorsoSupport:
     """How the simulated torso is held: free-floating unless --boom or --free-pitch asks for the boom (or the
     config says the robot walks on one, ``[robot] boom = true``)."""
     if args.free_pitch:
-        return "boom-pitch"
-    return "boom" if (args.boom or config.boom) else "free"
+        return TorsoSupport.BOOM_PITCH
+    return TorsoSupport.BOOM if (args.boom or config.boom) else TorsoSupport.FREE
 
 
 MAX_PUSH_NS = 20.0

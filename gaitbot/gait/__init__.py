@@ -6,7 +6,7 @@ Entry points: ``generate_walk`` (offline, whole trajectory), ``OnlineWalker`` (f
 
 from .geometry import TABLE1_LEG, LegGeometry
 from .planning import PlannedStep, perturb_steps, steps_for_distance
-from .segments import GaitGenerationError
+from .walk_segments import GaitGenerationError
 from .step_length import StepLengthError, StepLengthInverse
 from .joints import LEG_JOINTS, PITCH_JOINTS
 from .trajectory import HeelStrike, Trajectory, TrajectoryFileError

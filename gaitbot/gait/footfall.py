@@ -28,7 +28,7 @@ import numpy as np
 from .contact import ankle_in_body, grounded_ankle, leg_pitch, lowest_sole_y
 from .geometry import LegGeometry, ankle_position, leg_points
 from .joints import PITCH_JOINTS
-from .segments import CLEARANCE_WINDOW
+from .walk_segments import CLEARANCE_WINDOW
 from .trajectory import HeelStrike, Trajectory
 
 #: Contact tolerance as a share of the leg length: 2.2 mm for the 0.22 m leg of the shipped robots.
@@ -137,7 +137,7 @@ def root_from_contact(geometry: LegGeometry, angles_rad, start_root, land_tol: f
 
 def swing_clearances(geometry: LegGeometry, trajectory, tol_m: float | None = None) -> list[tuple[HeelStrike, float]]:
     """Per heel strike: the least height of the whole swing sole above flat ground from 20% to 80% of
-    the swing that ends in it (the walker's clearance rule, segments.CLEARANCE_WINDOW).
+    the swing that ends in it (the walker's clearance rule, walk_segments.CLEARANCE_WINDOW).
 
     The swing runs from the last frame the foot was within ``tol_m`` (default CONTACT_TOL_FRACTION of
     the leg) of the ground to the frame before it is back; heights use the trajectory's root, so the

@@ -1,6 +1,6 @@
 """How high a swing foot stays while it moves forward: one measure for every walk, flat or terrain.
 
-The walker and the terrain walker lift their swing feet by different means (segments.py, terrain/swing.py);
+The walker and the terrain walker lift their swing feet by different means (walk_segments.py, terrain/swing.py);
 this module measures the result on the frames alone, so both answer to one rule (docs/gait.md):
 
 - the sole is the whole of it, heel to toe (SOLE_POINTS points on the line between them), and its height is

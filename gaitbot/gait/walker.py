@@ -22,7 +22,7 @@ import numpy as np
 from .boulic import TABLE2_CYCLE_S
 from .geometry import LegGeometry
 from .planning import PlannedStep
-from .segments import CrouchSegment, GaitContext, SettleSegment, StepSegment
+from .walk_segments import CrouchSegment, GaitContext, SettleSegment, StepSegment
 from .step_length import StepLengthError, StepLengthInverse
 from .trajectory import HeelStrike, Trajectory
 
@@ -35,9 +35,9 @@ class WalkSettings:
     so that a step is a whole number of frames.
     clearance: least height of the whole swing sole from 20% to 80% of each swing.
     intermediate_steps: m of eq. 14, intermediate step lengths between consecutive steps.
-    crouch_knee_deg: knee bend of the start and end crouch (see segments.py for why).
+    crouch_knee_deg: knee bend of the start and end crouch (see walk_segments.py for why).
     settle_s: duration of the stand -> crouch and crouch -> stand phases.
-    pitch_limit_deg: the model's sole pitch is smoothly saturated to +- this (see segments.foot_of).
+    pitch_limit_deg: the model's sole pitch is smoothly saturated to +- this (see walk_segments.foot_of).
     """
 
     cycle_s: float = TABLE2_CYCLE_S
@@ -62,16 +62,31 @@ class WalkSettings:
 _INVERSE_CACHE: dict[tuple, StepLengthInverse] = {}
 
 
-def make_context(geometry: LegGeometry, settings: WalkSettings = WalkSettings()) -> GaitContext:
-    """Build (and cache) what every segment of a walk needs."""
-    step_frames = max(4, round(settings.cycle_s / 2.0 * settings.rate_hz))
-    cycle_s = 2.0 * step_frames / settings.rate_hz
+def _step_frames(settings: WalkSettings) -> int:
+    return max(4, round(settings.cycle_s / 2.0 * settings.rate_hz))
+
+
+def step_length_inverse(geometry: LegGeometry, settings: WalkSettings = WalkSettings()) -> StepLengthInverse:
+    """The Boulic step-length inverse of this leg at the settings' whole-frame cycle (built once, cached)."""
+    cycle_s = 2.0 * _step_frames(settings) / settings.rate_hz
     key = (geometry, cycle_s)
     if key not in _INVERSE_CACHE:
         _INVERSE_CACHE[key] = StepLengthInverse.build(geometry, cycle_s)
+    return _INVERSE_CACHE[key]
+
+
+def longest_step_m(geometry: LegGeometry, settings: WalkSettings = WalkSettings()) -> float:
+    """The longest step this leg reaches at the settings' cycle (Boulic region A, RV < 0.5): the bound of
+    the planar walker's steps, and of a balanced robot's, whose swing shapes come from it."""
+    return step_length_inverse(geometry, settings).max_step_length
+
+
+def make_context(geometry: LegGeometry, settings: WalkSettings = WalkSettings()) -> GaitContext:
+    """Build (and cache) what every segment of a walk needs."""
+    step_frames = _step_frames(settings)
     return GaitContext(
         geometry=geometry,
-        inverse=_INVERSE_CACHE[key],
+        inverse=step_length_inverse(geometry, settings),
         rate_hz=settings.rate_hz,
         step_frames=step_frames,
         clearance=settings.clearance,

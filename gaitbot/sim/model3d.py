@@ -18,6 +18,7 @@ P loop with back-EMF damping and the gearbox's armature, stiff contacts, <= 1 ms
 
 from __future__ import annotations
 
+from enum import Enum
 
 import numpy as np
 
@@ -27,7 +28,21 @@ from gaitbot.gait.kinematics6 import joint_axis
 from gaitbot.robot.config import RobotConfig
 from gaitbot.sim.model import LEG_RGBA, SOLE_THICKNESS_M, JointDrive, joint_drives, mjcf_document, substeps_per_frame
 
-SUPPORTS = ("free", "boom", "boom-pitch")
+class TorsoSupport(str, Enum):
+    """How the simulated torso is held; compares and hashes as its value ("free", "boom", "boom-pitch")."""
+
+    FREE = "free"  # free-floating
+    BOOM = "boom"  # slides along x and z, pitch held
+    BOOM_PITCH = "boom-pitch"  # the boom, with a free pitch hinge
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __hash__(self) -> int:
+        return hash(self.value)
+
+
+SUPPORTS = tuple(support.value for support in TorsoSupport)
 MIN_MOVING_LINK_KG = 1e-4  # MuJoCo needs mass on a body that moves; a massless link of a pitch-only leg gets this
 MIN_MOVING_LINK_INERTIA_KG_M2 = 1e-9
 

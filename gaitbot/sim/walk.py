@@ -19,7 +19,7 @@ import numpy as np
 
 from gaitbot.bus.base import Bus
 from gaitbot.bus.log import BusRecorder
-from gaitbot.gait.segments import CLEARANCE_WINDOW
+from gaitbot.gait.walk_segments import CLEARANCE_WINDOW
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.config import RobotConfig
 from gaitbot.sim.metrics import PlannedStrike, SimReport, SwingWindow, WalkMeter, WalkPlan

@@ -2,7 +2,7 @@
 
 ``clock`` (real and virtual time), ``pacing`` (frames on absolute deadlines, their statistics),
 ``ramps`` (rest-to-rest ramps and the braking stop), ``session`` (the walk session and its safe
-stop), ``record`` (the record-by-hand session), ``signals`` (SIGTERM as an exception, repeated signals), ``readback`` (the per-frame read-back).
+stop: ``WalkSession``), ``record`` (the record-by-hand session), ``signals`` (SIGTERM as an exception, repeated signals), ``readback`` (the per-frame read-back).
 
 Names are imported when first used, so ``gaitbot.stream.signals`` (which the command line installs
 before anything heavy is imported) stays light.
@@ -16,7 +16,8 @@ _NAMES = {
     "brake_ticks": "ramps", "ramp_ticks": "ramps", "stop_ticks": "ramps",
     "RecordResult": "record", "record_session": "record",
     "EXIT_CODES": "session", "MissingServosError": "session", "SessionResult": "session", "prepare": "session",
-    "walk_session": "session", "write_settings": "session",
+    "walk_session": "session", "write_settings": "session", "WalkSession": "session", "SessionLimits": "session",
+    "Outcome": "session", "FrameSource": "pacing",
     "Terminated": "signals", "sigterm_raises_terminated": "signals",
 }
 
@@ -24,7 +25,7 @@ __all__ = [
     "Clock", "MonotonicClock", "VirtualClock", "ramp_ticks", "brake_ticks", "stop_ticks",
     "StreamStats", "Streamer", "MissingServosError", "Terminated", "prepare", "write_settings", "paced_deadlines",
     "sigterm_raises_terminated", "SessionResult", "walk_session", "record_session", "RecordResult",
-    "LATE_THRESHOLD_S", "EXIT_CODES",
+    "LATE_THRESHOLD_S", "EXIT_CODES", "WalkSession", "SessionLimits", "Outcome", "FrameSource",
 ]
 
 

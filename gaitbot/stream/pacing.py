@@ -15,8 +15,9 @@ late against them.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
+from typing import Union
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -66,6 +67,9 @@ class StreamStats:
 
     def _record(self, lateness_s: float, bus_call_s: float) -> None:
         k = self.frames
+        if k == self.lateness_s.size:  # a frame source of unknown length: room for twice as many
+            self.lateness_s = np.concatenate([self.lateness_s, np.zeros(max(k, 64))])
+            self.bus_call_s = np.concatenate([self.bus_call_s, np.zeros(max(k, 64))])
         self.lateness_s[k] = lateness_s
         self.bus_call_s[k] = bus_call_s
         self.frames = k + 1
@@ -185,17 +189,22 @@ class Streamer:
         self.previous_sent_ticks: np.ndarray | None = None
         self.last_send_s: float | None = None
 
-    def run(self, frames: ArrayLike, start_s: float | None = None, previous_send_s: float | None = None) -> StreamStats:
-        """Stream ``frames`` (N, len(ids)) of int ticks; return their timing.
+    def run(self, frames: FrameSource, start_s: float | None = None, previous_send_s: float | None = None,
+            stop_requested: Callable[[], bool] | None = None) -> StreamStats:
+        """Stream ``frames`` (an (N, len(ids)) array of int ticks, or any iterable of such rows, taken one
+        at a time as they are due: a live walk plans each frame while the one before is on the wire);
+        return their timing.
 
         ``start_s`` is the first frame's deadline (default: now); a session passes the deadline
         after its previous run so consecutive runs keep one period apart on one absolute grid.
         ``next_deadline_s`` holds the deadline after the last frame sent (also when interrupted).
         ``previous_send_s``: when the frame before this run went out (a session's previous run), so the
         pacing rule holds across runs too: a stop ramp never follows a late walk frame by less than
-        ``min_frame_interval_s``. ``last_send_s`` holds the send time of this run's last frame."""
-        frames = as_tick_frames(frames, len(self.ids))
-        count = frames.shape[0]
+        ``min_frame_interval_s``. ``last_send_s`` holds the send time of this run's last frame.
+        ``stop_requested``: asked before each frame is sent (between bus exchanges, never inside one);
+        when it says so, ``run`` raises StopRequestedError without sending that frame."""
+        count = len(frames) if hasattr(frames, "__len__") else 0
+        source = tick_frames(frames, len(self.ids))
         stats = StreamStats(period_s=self.period_s, late_threshold_s=self.late_threshold_s,
                             lateness_s=np.zeros(count), bus_call_s=np.zeros(count))
         self.stats = stats
@@ -208,17 +217,20 @@ class Streamer:
             ticks = paced_deadlines(clock, self.period_s, start_s, self.min_frame_interval_s, earliest_s)
             last_write_s = previous_send_s
             min_interval_s = self.min_frame_interval_s
-            for _, (k, deadline_s, send_s) in zip(range(count), ticks):
+            for frame in source:
+                k, deadline_s, send_s = next(ticks)
+                if stop_requested is not None and stop_requested():
+                    raise StopRequestedError
                 work_cpu_start = cpu()
                 # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
                 # time: converting a whole one-hour walk up front would take ~100 MB.
-                goals = dict(zip(ids, frames[k].tolist()))
+                goals = dict(zip(ids, frame.tolist()))
                 # The pacing rule on the wire itself: had the host paused between the previous frame's
                 # start and its write, this write still waits the minimum interval after that one.
                 if last_write_s is not None and clock.now() < last_write_s + min_interval_s:
                     clock.sleep_until(last_write_s + min_interval_s)
                 last_write_s = self.last_send_s = clock.now()
-                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frames[k]
+                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frame
                 bus.write_goal_ticks(goals)
                 # The grid moves on as soon as the goals went out: whatever the read-back raises, the
                 # next frame sent (a stop ramp's first) is due one period after this one, not at once.
@@ -234,6 +246,10 @@ class Streamer:
         finally:
             stats.cpu_s = cpu() - cpu_start
         return stats
+
+
+class StopRequestedError(Exception):
+    """A frame was due, and ``stop_requested`` said stop: nothing of it was sent (pacing.Streamer.run)."""
 
 
 def paced_deadlines(clock: Clock, period_s: float, start_s: float, min_interval_s: float,
@@ -254,6 +270,18 @@ def paced_deadlines(clock: Clock, period_s: float, start_s: float, min_interval_
         yield k, deadline_s, work_s
         earliest_s = work_s + min_interval_s
         k += 1
+
+
+#: What a Streamer streams: a whole (N, J) array of ticks, or rows of J ticks handed over one at a time.
+FrameSource = Union[ArrayLike, Iterable[ArrayLike]]
+
+
+def tick_frames(frames: FrameSource, joint_count: int) -> Iterator[np.ndarray]:
+    """The rows of ``frames`` as int64 tick arrays of ``joint_count``: a whole array is checked at once,
+    rows from any other iterable (a live walk's frame source) one by one as they come."""
+    if isinstance(frames, (np.ndarray, list, tuple)):
+        return iter(as_tick_frames(frames, joint_count))
+    return (as_tick_frames(np.asarray(row).reshape(1, -1), joint_count)[0] for row in frames)
 
 
 def as_tick_frames(frames: ArrayLike, joint_count: int) -> np.ndarray:

@@ -1,15 +1,22 @@
 """The walk session: open, check, ramp to the first pose, walk, and leave the robot in a known pose.
 
 This room knows servo ids, ticks, a :class:`~gaitbot.bus.base.Bus` and a clock; joint names and
-angles were turned into ticks by the caller. Every way out leaves the robot in a known pose and
-closes the bus (which flushes a recording) in a ``finally``: see :func:`walk_session` and
-docs/bus-faults.md.
+angles were turned into ticks by the caller. :class:`WalkSession` holds the session's limits in one
+record (:class:`SessionLimits`) and takes its frames from a frame source (a whole array, or an
+iterator that plans each frame as it is due), on one thread, paced by the injected clock. Every way
+out leaves the robot in a known pose and closes the bus (which flushes a recording) in a
+``finally``; signals only set a flag that the loop acts on between bus exchanges, and a stop ramp,
+once started, always finishes (docs/bus-faults.md).
 """
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
+from enum import Enum
+
+import signal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -18,13 +25,39 @@ from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite
 from gaitbot.bus.log import RecordingFailed
 from gaitbot.stream.clock import Clock, MonotonicClock
 from gaitbot.stream.health import HealthMonitor, ServoHealthStop
-from gaitbot.stream.pacing import StreamStats, Streamer, as_tick_frames
+from gaitbot.stream.pacing import FrameSource, StopRequestedError, StreamStats, Streamer, as_tick_frames, tick_frames
 from gaitbot.stream.ramps import ramp_ticks, stop_ticks
 from gaitbot.stream.readback import ReadBackMonitor
-from gaitbot.stream.signals import Terminated, install_sigterm_handler, restore_sigterm_handler
+from gaitbot.stream.signals import StopSignals, Terminated, signals_deferred
 
-#: Exit codes by outcome, the shell's conventions (128 + SIGINT, 128 + SIGTERM).
-EXIT_CODES = {"completed": 0, "interrupted": 130, "terminated": 143, "bus_error": 1, "health_stop": 1}
+
+class Outcome(str, Enum):
+    """How a walk session ended; compares and hashes as its value ("completed", ...), which reports print."""
+
+    COMPLETED = "completed"
+    INTERRUPTED = "interrupted"  # Ctrl-C
+    TERMINATED = "terminated"  # SIGTERM
+    BUS_ERROR = "bus_error"
+    HEALTH_STOP = "health_stop"  # a servo's temperature or voltage reached its stop threshold
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __hash__(self) -> int:
+        return hash(self.value)
+
+    @property
+    def exit_code(self) -> int:
+        """The shell's conventions: 128 + SIGINT, 128 + SIGTERM; 1 for a fault."""
+        return {"completed": 0, "interrupted": 130, "terminated": 143}.get(self.value, 1)
+
+    @classmethod
+    def of_signal(cls, signum: int | None) -> Outcome:
+        return cls.TERMINATED if signum == signal.SIGTERM else cls.INTERRUPTED
+
+
+#: Exit codes by outcome.
+EXIT_CODES = {outcome.value: outcome.exit_code for outcome in Outcome}
 
 
 # --------------------------------------------------------------------------- before walking
@@ -78,20 +111,38 @@ def check_health(bus: Bus, ids: Sequence[int], health: HealthMonitor | None) -> 
 # --------------------------------------------------------------------------- the session
 
 @dataclass(frozen=True)
+class SessionLimits:
+    """What every motion the session plans itself (the start ramp, the stop ramps) keeps within, in
+    ticks, and the frame period the session runs at (seconds)."""
+
+    max_velocity_ticks_per_s: float
+    max_accel_ticks_per_s2: float
+    period_s: float = 1 / 60
+
+    def ramp(self, from_ticks: np.ndarray, to_ticks: np.ndarray) -> np.ndarray:
+        """Rest to rest (gaitbot.stream.ramps.ramp_ticks)."""
+        return ramp_ticks(from_ticks, to_ticks, self.max_velocity_ticks_per_s, self.max_accel_ticks_per_s2,
+                          self.period_s)
+
+    def stop(self, previous_ticks: np.ndarray, last_ticks: np.ndarray, stand_ticks: np.ndarray) -> np.ndarray:
+        """Brake from the motion under way, then ramp to ``stand_ticks`` (gaitbot.stream.ramps.stop_ticks)."""
+        return stop_ticks(previous_ticks, last_ticks, stand_ticks, self.max_velocity_ticks_per_s,
+                          self.max_accel_ticks_per_s2, self.period_s)
+
+
+@dataclass(frozen=True)
 class SessionResult:
     """How a walk session ended.
 
-    outcome: "completed" | "interrupted" | "terminated" | "bus_error" | "health_stop" (a servo's temperature
-    or voltage reached its stop threshold: gaitbot.stream.health).
-    exit_code: 0 | 130 | 143 | 1 | 1 respectively.
+    outcome: an :class:`Outcome`; exit_code its exit status (0, 130, 143, 1).
     error: the bus error that ended the walk (or stopped preparation), for the caller's message.
     walk_stats: timing of the walk itself (None if it never started).
-    reached_stand: the last frame sent is within 1 tick of ``stand_ticks`` (the ramp's own tolerance).
+    reached_stand: the last frame sent is within 1 tick of the stand pose (the ramp's own tolerance).
     torque_off: torque was switched off at the end.
     notes: what happened on the way out, one sentence each.
     """
 
-    outcome: str
+    outcome: Outcome
     exit_code: int
     error: BaseException | None = None
     walk_stats: StreamStats | None = None
@@ -103,7 +154,7 @@ class SessionResult:
         head = {"completed": "Walk completed", "interrupted": "Walk interrupted (Ctrl-C)",
                 "terminated": "Walk terminated (SIGTERM)", "bus_error": "Walk stopped by a bus error",
                 "health_stop": "Walk stopped to protect a servo"}
-        parts = [head.get(self.outcome, self.outcome)]
+        parts = [head.get(self.outcome, str(self.outcome))]
         if isinstance(self.error, RecordingFailed):
             parts = ["Walk stopped because the recording failed (the serial port is fine)"]
         if self.error is not None:
@@ -112,121 +163,255 @@ class SessionResult:
         return "; ".join(parts) + "."
 
 
-def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: ArrayLike, *,
+#: A stop ramp whose writes are interrupted by an exception (not a signal: signals never raise in a
+#: session) is planned again from where it was, at most this many times, so that it ends in bounded time.
+STOP_RAMP_RESTARTS = 10
+
+
+class WalkSession:
+    """One walk on one bus: :meth:`start` (open, check, gains, torque on, ramp to the first pose),
+    :meth:`stream` (the frames, from a frame source), :meth:`stop` (the stop ramp to the stand pose, torque
+    off if asked, close); :meth:`run` does all three and every way out.
+
+    The bus must not be opened yet; the session closes it. ``health``: the per-frame read-back reads
+    each servo's health block and the monitor judges it (gaitbot.stream.health), and every servo is
+    read once before torque on. ``monitor_servos``: read one servo back after each frame of the start
+    ramp, the walk and the final ramp (gaitbot.stream.readback); a stop ramp after a fault is not read
+    back (it must reach the healthy servos whatever the faulty one does). ``handle_signals``: SIGINT and
+    SIGTERM only set a flag while the session runs (main thread only; the old handlers come back after).
+    """
+
+    def __init__(self, bus: Bus, ids: Sequence[int], stand_ticks: ArrayLike, limits: SessionLimits, *,
+                 clock: Clock | None = None, torque_off_on_exit: bool = False,
+                 setup_writes: Sequence[RegisterWrite] = (), health: HealthMonitor | None = None,
+                 monitor_servos: bool = True, handle_signals: bool = True) -> None:
+        self.bus = bus
+        self.ids = [int(i) for i in ids]
+        self.stand = as_tick_frames(np.asarray(stand_ticks).reshape(1, -1), len(self.ids))[0]
+        self.limits = limits
+        self.clock = clock if clock is not None else MonotonicClock()
+        self.torque_off_on_exit = torque_off_on_exit
+        self.setup_writes = tuple(setup_writes)
+        self.health = health
+        self.handle_signals = handle_signals
+        self.read_back: ReadBackMonitor | None = None
+        if monitor_servos:
+            on_answer = None
+            if health is not None:  # the read-back reads each servo's health block and the monitor judges it
+                bus.set_read_back_blocks({i: (b.address, b.length) for i, b in health.blocks.items()})
+                on_answer = health.observe_read_back
+            self.read_back = ReadBackMonitor(bus, self.ids, self.clock, limits.period_s, on_answer=on_answer)
+        self.signals: StopSignals | None = None  # set while run() defers signals
+        self.state = _SessionState()
+
+    # ------------------------------------------------------------------ the three phases
+
+    def start(self, first_ticks: ArrayLike) -> bool:
+        """Open, check every servo (ping, present position, health), write the gains, write the present pose
+        as goal, torque on, and ramp to ``first_ticks``. True when the servos were already there (within a
+        tick): that pose was the goal written before torque on, and counts as the walk's first frame."""
+        first = as_tick_frames(np.asarray(first_ticks).reshape(1, -1), len(self.ids))[0]
+        bus, ids, state = self.bus, self.ids, self.state
+        state.opened = True  # close even if open fails halfway: a recording may already be started
+        bus.open()
+        present = prepare(bus, ids)
+        check_health(bus, ids, self.health)
+        write_settings(bus, self.setup_writes)
+        self._act_on_signals()
+        at_start = int(np.max(np.abs(present - first))) <= 1
+        first_goal = first if at_start else present
+        first_sent_s = self.clock.now()
+        bus.write_goal_ticks(dict(zip(ids, first_goal.tolist())))  # a servo enabled with a stale goal would jump
+        state.last_sent, state.last_send_s = first_goal, first_sent_s
+        state.torque_on = True  # before the call: a torque-on that fails halfway still gets its torque-off
+        bus.set_torque(ids, True)
+        state.next_deadline_s = first_sent_s + self.limits.period_s
+        if not at_start:
+            self._run(self._streamer(monitored=True), self.limits.ramp(present, first), watch_signals=True)
+        return at_start
+
+    def stream(self, frames: FrameSource, on_frame: Callable[[int, StreamStats], None] | None = None) -> StreamStats:
+        """Stream the frames, each when it is due; a deferred signal stops it between two frames."""
+        self._run(self._streamer(on_frame, monitored=True), frames, is_walk=True, watch_signals=True)
+        return self.state.walk_stats
+
+    def stop(self, monitored: bool = False) -> bool:
+        """Ramp from the motion under way (the last two frames sent) to the stand pose, and finish it whatever
+        signals arrive. ``monitored``: read the servos back meanwhile (the end of a healthy walk). False
+        when nothing had moved (torque never went on)."""
+        state = self.state
+        if not state.torque_on or state.last_sent is None:
+            return False  # nothing moved: the robot is where it was
+        previous = state.previous_sent if state.previous_sent is not None else state.last_sent
+        ramp = self.limits.stop(previous, state.last_sent, self.stand)
+        for _ in range(STOP_RAMP_RESTARTS):
+            streamer = self._streamer(monitored=monitored)
+            try:
+                self._run(streamer, ramp)
+                return True
+            except (KeyboardInterrupt, Terminated):  # raised by a bus, not by a signal of ours (those never raise)
+                # that frame's write was cut short: the ramp goes on with it
+                ramp = ramp[streamer.stats.frames:]
+                state.notes_once("a stop ramp write was interrupted, and the ramp went on")
+        state.notes.append("stop ramp given up after repeated interrupted writes")
+        return True
+
+    def finish(self) -> None:
+        """Torque off if asked (not when the port is gone)."""
+        state = self.state
+        if not (self.torque_off_on_exit and state.torque_on) or state.port_lost:
+            return
+        try:
+            self.bus.set_torque(self.ids, False)
+            state.torque_off = True
+            state.notes.append("torque off")
+        except (KeyboardInterrupt, Terminated):
+            state.notes.append("torque off abandoned on an interrupt")
+        except BusError as exc:
+            state.notes.append(f"torque off failed: {exc}")
+
+    def close(self) -> None:
+        """Close once, whatever happens: a failure or an interrupt becomes a note (closing flushes a
+        recording made by the bus room, so it is never skipped, and must not hide how the walk ended)."""
+        if not self.state.opened:
+            return
+        self.state.opened = False
+        try:
+            self.bus.close()
+        except (KeyboardInterrupt, Terminated):
+            self.state.notes.append("closing the bus was interrupted")
+        except Exception as exc:  # noqa: BLE001 - reported to the caller in the notes
+            self.state.notes.append(f"closing the bus failed: {exc}")
+
+    # ------------------------------------------------------------------ the whole session
+
+    def run(self, frames: FrameSource, on_frame: Callable[[int, StreamStats], None] | None = None) -> SessionResult:
+        """Start, stream, stop, with every way out (docs/bus-faults.md): completed 0, interrupted 130,
+        terminated 143, bus_error and health_stop 1. A PortError (the port is gone) skips the stop ramp and
+        the torque-off: nothing could reach the servos. Other exceptions (bugs) get the safe stop and are
+        raised again."""
+        if isinstance(frames, (np.ndarray, list, tuple)):
+            frames = as_tick_frames(frames, len(self.ids))  # checked before anything is opened
+            if frames.shape[0] == 0:
+                raise ValueError("frames is empty: nothing to walk")
+        deferring = signals_deferred() if self.handle_signals else _no_signals()
+        try:
+            with deferring as self.signals:
+                outcome, error = self._walk(frames, on_frame)
+                self.finish()
+        finally:
+            self.close()
+        if outcome is Outcome.COMPLETED and self.signals is not None and self.signals.pending:
+            outcome = Outcome.of_signal(self.signals.pending[0])  # arrived during the final ramp, which finished
+        state = self.state
+        return SessionResult(outcome=outcome, exit_code=outcome.exit_code, error=error, walk_stats=state.walk_stats,
+                             reached_stand=state.last_sent is not None
+                             and int(np.max(np.abs(state.last_sent - self.stand))) <= 1,
+                             torque_off=state.torque_off, notes=tuple(state.notes))
+
+    def _first_and_rest(self, frames: FrameSource) -> tuple[np.ndarray, FrameSource]:
+        """The first frame (checked: the start ramp goes there) and the others (a whole array is checked at
+        once; a frame source's rows are checked by the Streamer as they come)."""
+        if isinstance(frames, (np.ndarray, list, tuple)):
+            walk = as_tick_frames(frames, len(self.ids))
+            if walk.shape[0] == 0:
+                raise ValueError("frames is empty: nothing to walk")
+            return walk[0], walk[1:]
+        source = iter(frames)
+        first = next(source, None)
+        if first is None:
+            raise ValueError("the frame source is empty: nothing to walk")
+        return next(tick_frames([np.asarray(first).reshape(-1)], len(self.ids))), source
+
+    def _walk(self, frames: FrameSource, on_frame) -> tuple[Outcome, BaseException | None]:
+        """The phases, and the way out each exception takes; returns (outcome, error)."""
+        first, rest = self._first_and_rest(frames)
+        try:
+            at_start = self.start(first)
+            if not at_start:  # the ramp went to the first frame; the walk starts with it
+                rest = np.asarray(frames) if isinstance(rest, np.ndarray) else itertools.chain([first], rest)
+            self.stream(rest, on_frame)
+            self.stop(monitored=True)
+            return Outcome.COMPLETED, None
+        except StopRequestedError:
+            outcome, error = Outcome.of_signal(self.signals.pending[0] if self.signals else None), None
+        except (KeyboardInterrupt, Terminated) as exc:  # raised by a bus or off the main thread
+            outcome, error = (Outcome.TERMINATED if isinstance(exc, Terminated) else Outcome.INTERRUPTED), None
+        except ServoHealthStop as exc:  # a servo too hot or under-powered: the safe stop of a bus fault
+            outcome, error = Outcome.HEALTH_STOP, exc
+        except BusError as exc:
+            if isinstance(exc, PortError) and self.state.torque_on:
+                self.state.port_lost = True
+                self.state.notes.append("the port is gone, so no stop ramp or torque-off could be sent: "
+                                        "the servos hold their last goal")
+                return Outcome.BUS_ERROR, exc
+            self._safe_stop()
+            return Outcome.BUS_ERROR, self._explain(exc)
+        except Exception:
+            self._safe_stop()
+            self.finish()
+            raise
+        self._safe_stop()
+        return outcome, error
+
+    def _safe_stop(self) -> None:
+        try:
+            if self.stop():
+                self.state.notes.append("ramped to the stand pose")
+        except BusError as exc:
+            self.state.notes.append(f"stop ramp abandoned: {exc}")
+
+    def _explain(self, exc: BusError) -> BaseException:
+        """The fault in words, read once the robot is safe (a bus may read the servo's error register)."""
+        explain = getattr(self.bus, "explain_status_error", None)
+        if not callable(explain):
+            return exc
+        try:
+            return explain(exc)
+        except (KeyboardInterrupt, Terminated):
+            return exc
+
+    # ------------------------------------------------------------------ helpers
+
+    def _act_on_signals(self) -> None:
+        if self.signals is not None and self.signals.pending:
+            raise StopRequestedError
+
+    def _stop_requested(self) -> bool:
+        return bool(self.signals is not None and self.signals.pending)
+
+    def _streamer(self, on_frame=None, monitored: bool = False) -> Streamer:
+        return Streamer(self.bus, self.ids, self.limits.period_s, self.clock, on_frame,
+                        monitor=self.read_back if monitored else None)
+
+    def _run(self, streamer: Streamer, frames: FrameSource, is_walk: bool = False, watch_signals: bool = False) -> None:
+        self.state.run(streamer, frames, is_walk, self._stop_requested if watch_signals else None)
+
+
+class _no_signals:  # noqa: N801 - a context manager standing in for signals_deferred
+    def __enter__(self):
+        return None
+
+    def __exit__(self, *exc) -> bool:
+        return False
+
+
+def walk_session(bus: Bus, ids: Sequence[int], frames: FrameSource, stand_ticks: ArrayLike, *,
                  max_velocity_ticks_per_s: float, max_accel_ticks_per_s2: float,
                  period_s: float = 1 / 60, clock: Clock | None = None,
                  torque_off_on_exit: bool = False,
                  on_frame: Callable[[int, StreamStats], None] | None = None,
                  handle_sigterm: bool = True, monitor_servos: bool = True,
                  setup_writes: Sequence[RegisterWrite] = (), health: HealthMonitor | None = None) -> SessionResult:
-    """Open, check, ramp to the first pose, walk, and leave the robot in a known pose.
+    """One :class:`WalkSession` run, in one call (the public API's shape: ``gaitbot.walk_session``).
 
-    Sequence: ``bus.open()`` -> :func:`prepare` (ping all, read present) -> ``setup_writes`` (the
-    servos' gains) -> present pose as goal, then torque on (a servo enabled with a stale goal register
-    would jump to it) -> ramp to ``frames[0]`` -> stream ``frames`` -> end. Ways out (completed 0,
-    interrupted 130, terminated 143, bus_error 1) and the safe stop (brake at the acceleration limit
-    from the motion under way, then ramp to ``stand_ticks``) are in docs/bus-faults.md; in every case
-    torque goes off if ``torque_off_on_exit`` and the bus is closed in a ``finally`` (which flushes a
-    recording). A PortError (the port is gone) skips the stop ramp and the torque-off: nothing could
-    reach the servos.
-
-    ``monitor_servos``: after every frame of the start ramp, the walk and the final ramp one servo is
-    read back within what is left of that frame (gaitbot.stream.readback: never waited on, never
-    retried inside a frame), so a servo that stops answering or reports error bits ends the walk
-    within ``len(ids)`` + READ_BACK_MISSES frames; the safe stop ramp is not read back (it must reach
-    the healthy servos whatever the faulty one does). ``handle_sigterm``: SIGTERM raises
-    :class:`~gaitbot.stream.signals.Terminated` (main thread only; the old handler is restored).
-
-    ``health``: that read-back reads the servo's whole health block instead (position, temperature,
-    voltage, load: the same one READ, ``Bus.set_read_back_blocks``) and hands it to the monitor, which warns or stops the
-    walk (outcome "health_stop", the safe stop of a bus fault, exit 1); every servo is also read once
-    before torque goes on, so a robot already too hot or on a flat battery does not start.
-    """
-    ids = [int(i) for i in ids]
-    walk = as_tick_frames(frames, len(ids))
-    if walk.shape[0] == 0:
-        raise ValueError("frames is empty: nothing to walk")
-    stand = as_tick_frames(np.asarray(stand_ticks).reshape(1, -1), len(ids))[0]
-    clock = clock if clock is not None else MonotonicClock()
-
-    def ramp(from_ticks: np.ndarray, to_ticks: np.ndarray) -> np.ndarray:
-        return ramp_ticks(from_ticks, to_ticks, max_velocity_ticks_per_s, max_accel_ticks_per_s2, period_s)
-
-    def stop(previous_ticks: np.ndarray, last_ticks: np.ndarray) -> np.ndarray:
-        return stop_ticks(previous_ticks, last_ticks, stand, max_velocity_ticks_per_s, max_accel_ticks_per_s2,
-                          period_s)
-
-    read_back = None
-    if monitor_servos:
-        on_answer = None
-        if health is not None:  # the read-back reads each servo's health block and the monitor judges it
-            bus.set_read_back_blocks({i: (b.address, b.length) for i, b in health.blocks.items()})
-            on_answer = health.observe_read_back
-        read_back = ReadBackMonitor(bus, ids, clock, period_s, on_answer=on_answer)
-
-    def streamer(callback=None, monitored: bool = False) -> Streamer:
-        return Streamer(bus, ids, period_s, clock, callback, monitor=read_back if monitored else None)
-
-    old_handler = install_sigterm_handler() if handle_sigterm else None
-    state = _SessionState()
-    try:
-        try:
-            state.opened = True  # close even if open fails halfway: a recording may already be started
-            bus.open()
-            present = prepare(bus, ids)
-            check_health(bus, ids, health)
-            write_settings(bus, setup_writes)
-            # Already at the first pose (within a tick): that pose is the goal written before torque on,
-            # and it counts as the walk's first frame, so a recording holds exactly the trajectory.
-            at_start = int(np.max(np.abs(present - walk[0]))) <= 1
-            first_goal = walk[0] if at_start else present
-            first_sent_s = clock.now()
-            bus.write_goal_ticks(dict(zip(ids, first_goal.tolist())))
-            state.last_sent = first_goal
-            state.last_send_s = first_sent_s
-            state.torque_on = True  # before the call: a torque-on that fails halfway still gets its torque-off
-            bus.set_torque(ids, True)
-            state.next_deadline_s = first_sent_s + period_s
-            if not at_start:
-                state.run(streamer(monitored=True), ramp(present, walk[0]))
-            state.run(streamer(on_frame, monitored=True), walk[1:] if at_start else walk, is_walk=True)
-            state.run(streamer(monitored=True), stop(walk[-2] if len(walk) > 1 else walk[-1], walk[-1]))
-            outcome, error = "completed", None
-        except (KeyboardInterrupt, Terminated) as exc:
-            outcome, error = ("terminated" if isinstance(exc, Terminated) else "interrupted"), None
-            state.safe_stop(streamer, stop)
-        except ServoHealthStop as exc:  # a servo too hot or under-powered: the safe stop of a bus fault
-            outcome, error = "health_stop", exc
-            state.safe_stop(streamer, stop)
-        except BusError as exc:
-            outcome, error = "bus_error", exc
-            if isinstance(exc, PortError) and state.torque_on:
-                state.port_lost = True
-                state.notes.append("the port is gone, so no stop ramp or torque-off could be sent: "
-                                   "the servos hold their last goal")
-            else:
-                state.safe_stop(streamer, stop)
-                explain = getattr(bus, "explain_status_error", None)
-                if callable(explain):  # the robot is safe now: time to read what the fault was
-                    try:
-                        error = explain(exc)
-                    except (KeyboardInterrupt, Terminated):
-                        pass
-        except Exception:
-            state.safe_stop(streamer, stop)
-            state.finish(bus, ids, torque_off_on_exit)
-            raise
-        state.finish(bus, ids, torque_off_on_exit)
-    finally:
-        try:
-            state.close(bus)
-        finally:
-            if handle_sigterm:
-                restore_sigterm_handler(old_handler)
-    return SessionResult(
-        outcome=outcome, exit_code=EXIT_CODES[outcome], error=error, walk_stats=state.walk_stats,
-        reached_stand=state.last_sent is not None and int(np.max(np.abs(state.last_sent - stand))) <= 1,
-        torque_off=state.torque_off, notes=tuple(state.notes))
+    ``handle_sigterm``: SIGINT and SIGTERM set the session's stop flag while it runs (main thread only);
+    the rest is :class:`WalkSession`'s."""
+    limits = SessionLimits(max_velocity_ticks_per_s, max_accel_ticks_per_s2, period_s)
+    session = WalkSession(bus, ids, stand_ticks, limits, clock=clock, torque_off_on_exit=torque_off_on_exit,
+                          setup_writes=setup_writes, health=health, monitor_servos=monitor_servos,
+                          handle_signals=handle_sigterm)
+    return session.run(frames, on_frame)
 
 
 class _SessionState:
@@ -244,9 +429,14 @@ class _SessionState:
         self.next_deadline_s: float | None = None  # keeps consecutive runs on one frame grid
         self.last_send_s: float | None = None  # when the last frame went out: the pacing rule across runs
 
-    def run(self, streamer: Streamer, frames: np.ndarray, is_walk: bool = False) -> None:
+    def notes_once(self, note: str) -> None:
+        if note not in self.notes:
+            self.notes.append(note)
+
+    def run(self, streamer: Streamer, frames: FrameSource, is_walk: bool = False,
+            stop_requested: Callable[[], bool] | None = None) -> None:
         try:
-            stats = streamer.run(frames, self.next_deadline_s, self.last_send_s)
+            stats = streamer.run(frames, self.next_deadline_s, self.last_send_s, stop_requested)
         finally:
             self.next_deadline_s = getattr(streamer, "next_deadline_s", self.next_deadline_s)
             self.last_send_s = getattr(streamer, "last_send_s", None) or self.last_send_s
@@ -258,44 +448,3 @@ class _SessionState:
                 self.walk_stats = streamer.stats
         if is_walk:
             self.walk_stats = stats
-
-    def safe_stop(self, streamer: Callable[[], Streamer],
-                  stop: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> None:
-        """Brake and ramp from the last sent pose to stand, once; give up on a bus error or a second signal."""
-        if not self.torque_on or self.last_sent is None:
-            return  # nothing moved: the robot is where it was
-        previous = self.previous_sent if self.previous_sent is not None else self.last_sent
-        try:
-            self.run(streamer(), stop(previous, self.last_sent))
-            self.notes.append("ramped to the stand pose")
-        except (KeyboardInterrupt, Terminated):
-            self.notes.append("stop ramp abandoned on a second interrupt")
-        except BusError as exc:
-            self.notes.append(f"stop ramp abandoned: {exc}")
-
-    def finish(self, bus: Bus, ids: list[int], torque_off_on_exit: bool) -> None:
-        if not (torque_off_on_exit and self.torque_on) or self.port_lost:
-            return
-        try:
-            bus.set_torque(ids, False)
-            self.torque_off = True
-            self.notes.append("torque off")
-        except (KeyboardInterrupt, Terminated):
-            self.notes.append("torque off abandoned on an interrupt")
-        except BusError as exc:
-            self.notes.append(f"torque off failed: {exc}")
-
-    def close(self, bus: Bus) -> None:
-        """Close once, whatever happens: a failure or a further interrupt becomes a note.
-
-        Closing flushes a recording made by the bus room, so it must not be skipped, and an
-        error here must not hide how the walk ended.
-        """
-        if not self.opened:
-            return
-        try:
-            bus.close()
-        except (KeyboardInterrupt, Terminated):
-            self.notes.append("closing the bus was interrupted")
-        except Exception as exc:  # noqa: BLE001 - reported to the caller in the notes
-            self.notes.append(f"closing the bus failed: {exc}")

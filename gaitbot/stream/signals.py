@@ -1,7 +1,11 @@
-"""SIGTERM as an exception in the main thread, so a session stops the way it does on Ctrl-C; and what
-repeated signals do (docs/bus-faults.md): the first Ctrl-C or SIGTERM starts the safe stop, the second
-forces the stop without the ramp, later ones are ignored while gaitbot switches torque off (if
-configured), closes the port and reports."""
+"""Ctrl-C and SIGTERM (docs/bus-faults.md).
+
+Outside a walk session (imports, planning, a recording by hand) the first two raise KeyboardInterrupt or
+:class:`Terminated` in the main thread, later ones are only counted. While a session owns the bus they
+only set a flag (:meth:`StopSignals.deferring`): a handler that raised in the middle of a bus exchange
+would leave the exchange half done (and the SDK's port lock taken), so the session's loop looks at the
+flag between exchanges, starts the safe stop, and finishes every stop ramp whatever signals follow.
+"""
 
 from __future__ import annotations
 
@@ -30,24 +34,41 @@ RAISING_SIGNALS = 2
 
 class StopSignals:
     """SIGINT and SIGTERM for a whole command (``install``/``restore`` from the main thread): the first
-    two raise KeyboardInterrupt or Terminated, later ones are only counted (``ignored``)."""
+    two raise KeyboardInterrupt or Terminated, later ones are only counted (``ignored``); within
+    :meth:`deferring` none raises, each is kept in ``pending`` for the session to act on."""
 
     def __init__(self) -> None:
         self.received = 0
         self.ignored = 0
         self.first_signal: int | None = None
+        self.deferred = False
+        self.pending: list[int] = []
         self._old: dict[int, object] = {}
 
     def handler(self, signum: int, _frame: object) -> None:
         self.received += 1
         if self.first_signal is None:
             self.first_signal = signum
+        if self.deferred:
+            self.pending.append(signum)
+            return
         if self.received > RAISING_SIGNALS:
             self.ignored += 1
             return
         if signum == signal.SIGTERM:
             raise Terminated(f"received signal {signum}")
         raise KeyboardInterrupt
+
+    @contextmanager
+    def deferring(self):
+        """Within the block signals only set the flag (``pending``); a session checks it between exchanges."""
+        was = self.deferred
+        self.deferred = True
+        self.pending.clear()
+        try:
+            yield self
+        finally:
+            self.deferred = was
 
     def install(self) -> bool:
         if threading.current_thread() is not threading.main_thread():
@@ -72,10 +93,38 @@ class StopSignals:
 
 def stop_signals_installed() -> bool:
     """True when a StopSignals policy handles SIGTERM now (a command installed it for its whole run)."""
+    return installed_stop_signals() is not None
+
+
+def installed_stop_signals() -> StopSignals | None:
+    """The StopSignals policy handling SIGINT and SIGTERM now, if any (main thread only)."""
     if threading.current_thread() is not threading.main_thread():
-        return False
-    handler = signal.getsignal(signal.SIGTERM)
-    return isinstance(getattr(handler, "__self__", None), StopSignals)
+        return None
+    policy = getattr(signal.getsignal(signal.SIGTERM), "__self__", None)
+    if isinstance(policy, StopSignals) and getattr(signal.getsignal(signal.SIGINT), "__self__", None) is policy:
+        return policy
+    return None
+
+
+@contextmanager
+def signals_deferred():
+    """Within the block SIGINT and SIGTERM only set a flag: yields the StopSignals whose ``pending`` holds
+    them (the command's own policy if it installed one, else one installed for the block and then
+    removed), or None off the main thread, where no handler can be set."""
+    policy = installed_stop_signals()
+    own = policy is None and threading.current_thread() is threading.main_thread()
+    if own:
+        policy = StopSignals()
+        policy.install()
+    if policy is None:
+        yield None
+        return
+    try:
+        with policy.deferring():
+            yield policy
+    finally:
+        if own:
+            policy.restore()
 
 
 @contextmanager

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from gaitbot.gait.balance.flat_frame import FlatFootBody
+from gaitbot.gait.balance.flat_foot_body import FlatFootBody
 from gaitbot.gait.balance.preview import PreviewController, preview_gains, preview_offline
 from gaitbot.gait.balance.speed_fit import fit_to_servo_speed
 from gaitbot.gait.balance.walker import BalancedWalkError, generate_balanced_walk

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from gaitbot.app.cli import build_parser
-from gaitbot.app.steer_walk import commanded_pose, planned_pose, steered_walk
-from gaitbot.app.walks import trajectory_for_robot
+from gaitbot.app.planned_walk import planned_walk
+from gaitbot.app.steer_walk import commanded_pose, planned_pose
 from gaitbot.gait.body import SIDE_SIGN
 from gaitbot.gait.joints import SIDES
 from gaitbot.gait.kinematics6 import foot_pose, sole_corners
@@ -40,10 +40,11 @@ def args_for(*argv):
 
 
 def test_a_straight_velocity_walk_is_the_steps_walk_of_the_same_steps():
-    _, plan, trajectory = steered_walk(args_for("--velocity", "0.07,0,0", "--duration", "3"))
+    walk = planned_walk(args_for("--velocity", "0.07,0,0", "--duration", "3"))
+    plan, trajectory = walk.plan, walk.planned
     lengths = [f.length_m for f in plan.footsteps]
     assert lengths[0] < lengths[1] and lengths[-1] == 0.0  # the ramp up, and the closing step
-    _, _, straight = trajectory_for_robot(args_for("--steps", ",".join(repr(x) for x in lengths)))
+    straight = planned_walk(args_for("--steps", ",".join(repr(x) for x in lengths))).planned
     assert np.array_equal(trajectory.angles_rad, straight.angles_rad)
     assert np.array_equal(trajectory.root_m, straight.root_m)
     assert trajectory.torso_rpy_rad is None and trajectory.heel_strikes == straight.heel_strikes

@@ -10,7 +10,8 @@ pytest.importorskip("matplotlib")
 
 from gaitbot.gait.terrain.course_file import load_course  # noqa: E402
 from gaitbot.plot.figures import MAX_POSES, ground_profile, sole_clearance, trajectory_figure  # noqa: E402
-from gaitbot.app.walks import build_terrain_walk  # noqa: E402
+from gaitbot.app.options import gait_source  # noqa: E402
+from gaitbot.app.planned_walk import terrain_walk  # noqa: E402
 from helpers import CONFIG_DIR, fk_foot, config  # noqa: E402
 
 KERB = CONFIG_DIR / "terrain" / "kerb.toml"
@@ -20,8 +21,8 @@ KERB = CONFIG_DIR / "terrain" / "kerb.toml"
 def kerb():
     from argparse import Namespace
 
-    source, walk = build_terrain_walk(Namespace(robot=None, terrain=str(KERB), thigh=None, shank=None, foot=None,
-                                                clearance=None, rate=None))
+    source = gait_source(Namespace(robot=None, thigh=None, shank=None, foot=None, clearance=None, rate=None))
+    walk = terrain_walk(source, str(KERB))
     return source, walk.trajectory, load_course(KERB).terrain
 
 

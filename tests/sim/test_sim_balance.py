@@ -133,7 +133,7 @@ def test_a_pitch_only_robot_free_standing_is_refused_and_would_fall_sideways(tmp
     sys.path.insert(0, str(REPO_ROOT / "tools"))
     import robustness
 
-    from gaitbot.app.walks import trajectory_for_robot
+    from gaitbot.app.planned_walk import planned_walk
     from gaitbot.robot.config import load_robot_config
 
     text = (REPO_ROOT / "config" / "xl430-biped.toml").read_text()
@@ -146,8 +146,8 @@ def test_a_pitch_only_robot_free_standing_is_refused_and_would_fall_sideways(tmp
     assert "walk refused before anything moved" in err and "zmp" in err
     config = load_robot_config(path)
     args = robustness.plan_arguments(["--distance", "0.5"], robot=str(path))
-    _, walker, planned = trajectory_for_robot(args)
-    row = robustness.play_ours(config, walker, planned, planned, error_deg=config.servo.full_torque_error_deg)
+    walk = planned_walk(args)
+    row = robustness.play_ours(config, walk.plan, walk.planned, walk.planned, error_deg=config.servo.full_torque_error_deg)
     assert row["fell"] and row["fall_direction"].startswith("sideways"), row
     assert 0.5 < row["fell_at_s"] < 4.0
 

@@ -567,11 +567,16 @@ def test_sigterm_ramps_to_stand_exits_143_and_restores_the_old_handler():
         signal.signal(signal.SIGTERM, previous)
     assert called == []  # our handler took it, not the sentinel
     assert result.outcome == "terminated" and result.exit_code == 143
-    check_stop_ramp(walk[k - 1], walk[k], split_at_interrupt(bus, walk, k))
+    # the signal only set the session's flag: the write it landed in went out whole, and the loop stopped
+    # before the next frame, braking from the motion of frames k-1 and k
+    assert result.walk_stats.frames == k + 1
+    check_stop_ramp(walk[k - 1], walk[k], split_at_interrupt(bus, walk, k + 1))
     assert result.torque_off and bus.closed
 
 
-def test_second_ctrl_c_abandons_the_stop_ramp_and_turns_torque_off():
+def test_a_second_interrupt_does_not_abandon_the_stop_ramp():
+    """A KeyboardInterrupt raised by the bus inside a stop-ramp write (signals of the session's own never
+    raise: see the next test) does not end the ramp: it goes on, braking from where it was, to STAND."""
     k = 30
 
     def ctrl_c():
@@ -583,13 +588,28 @@ def test_second_ctrl_c_abandons_the_stop_ramp_and_turns_torque_off():
     bus = start_pose_bus(clock, on_write=hook)
     result = session(bus, clock, frames=walk)
     assert result.outcome == "interrupted" and result.exit_code == 130
-    walk_start = hook.state["walk_start"]
-    # every attempt before the first Ctrl-C went out, then two stop-ramp frames, then nothing
-    assert len(bus.writes) == walk_start + k + 2
-    assert bus.write_attempts == walk_start + k + 4
-    assert not result.reached_stand
+    assert result.reached_stand
+    np.testing.assert_array_equal(bus.write_ticks()[-1], STAND)
+    # the interrupted ramp frame never went out and is sent again: the writes are the one planned stop ramp
+    check_stop_ramp(walk[k - 1], walk[k], split_at_interrupt(bus, walk, k))
     assert result.torque_off and bus.names()[-2:] == ["set_torque", "close"]
-    assert any("abandoned" in note for note in result.notes)
+
+
+@pytest.mark.parametrize("signals", [[signal.SIGINT, signal.SIGINT], [signal.SIGTERM, signal.SIGINT, signal.SIGTERM]])
+def test_signals_during_the_stop_ramp_only_set_the_flag_and_the_ramp_finishes(signals):
+    """Real signals while a session runs (the first at walk frame k, the others in the stop ramp): none raises
+    inside a bus exchange, the stop ramp goes out whole to STAND, and the outcome is the first signal's."""
+    k = 30
+    raisers = {k + i * 2: (lambda s=s: os.kill(os.getpid(), s)) for i, s in enumerate(signals)}
+    hook, walk = raise_at_walk_frames(raisers)
+    clock = VirtualClock()
+    bus = start_pose_bus(clock, on_write=hook)
+    result = session(bus, clock, frames=walk)
+    expected = "terminated" if signals[0] == signal.SIGTERM else "interrupted"
+    assert result.outcome == expected and result.reached_stand and result.torque_off
+    assert result.walk_stats.frames == k + 1
+    check_stop_ramp(walk[k - 1], walk[k], split_at_interrupt(bus, walk, k + 1))
+    assert bus.write_attempts == len(bus.writes)  # no write was cut short
 
 
 def test_dead_bus_gives_exit_1_without_hanging():
@@ -713,3 +733,55 @@ def test_a_failing_close_is_reported_and_the_sigterm_handler_still_restored(clos
         signal.signal(signal.SIGTERM, previous)
     assert result.outcome == "completed" and bus.closed
     assert any("closing the bus" in note for note in result.notes)
+
+
+# --------------------------------------------------------------------------- WalkSession and frame sources
+
+def test_a_frame_source_is_pulled_one_frame_at_a_time_and_sends_what_the_array_sends():
+    """A live walk hands the session an iterator: each frame is taken only when it is due (after the frame
+    before it went out), and the writes, their times and the stop are those of the same frames as an array."""
+    from gaitbot.stream.session import SessionLimits, WalkSession
+
+    walk = gait_frames()
+    clock_a = VirtualClock(bus_call_cost_s=0.001)
+    bus_a = start_pose_bus(clock_a)
+    by_array = session(bus_a, clock_a, frames=walk)
+
+    clock_b = VirtualClock(bus_call_cost_s=0.001)
+    bus_b = start_pose_bus(clock_b)
+    writes_when_pulled = []
+
+    def frame_source():
+        for frame in walk:
+            writes_when_pulled.append(len(bus_b.writes))
+            yield frame.tolist()  # any row of ticks will do
+
+    live = WalkSession(bus_b, IDS, STAND, SessionLimits(VMAX, AMAX, PERIOD_S), clock=clock_b, torque_off_on_exit=True)
+    by_source = live.run(frame_source())
+    assert by_source.outcome == by_array.outcome == "completed" and by_source.exit_code == 0
+    assert [(t, g) for t, g in bus_b.writes] == [(t, g) for t, g in bus_a.writes]
+    assert by_source.walk_stats.frames == by_array.walk_stats.frames
+    # frame k (k >= 2) is pulled after frame k - 1 was written: never ahead of the stream
+    start = writes_when_pulled[1]
+    assert writes_when_pulled[1:] == list(range(start, start + len(walk) - 1))
+
+
+def test_a_frame_source_that_ends_early_still_ends_standing():
+    """A live walk that stops producing frames (its planner ended the walk anywhere) gets the final ramp."""
+    from gaitbot.stream.session import SessionLimits, WalkSession
+
+    clock = VirtualClock()
+    bus = start_pose_bus(clock)
+    result = WalkSession(bus, IDS, STAND, SessionLimits(VMAX, AMAX, PERIOD_S), clock=clock).run(iter(gait_frames()[:45]))
+    assert result.outcome == "completed" and result.reached_stand
+    np.testing.assert_array_equal(bus.write_ticks()[-1], STAND)
+
+
+def test_session_limits_are_one_record_and_outcomes_compare_as_their_names():
+    from gaitbot.stream.session import Outcome, SessionLimits
+
+    limits = SessionLimits(VMAX, AMAX, PERIOD_S)
+    ramp = limits.ramp(np.full(4, 1000), STAND)
+    np.testing.assert_array_equal(ramp, ramp_ticks(np.full(4, 1000), STAND, VMAX, AMAX, PERIOD_S))
+    assert Outcome.TERMINATED == "terminated" and {"terminated": 1}[Outcome.TERMINATED] == 1
+    assert [o.exit_code for o in Outcome] == [0, 128 + signal.SIGINT, 128 + signal.SIGTERM, 1, 1]

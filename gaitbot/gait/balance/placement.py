@@ -6,7 +6,7 @@ link's mass (gaitbot.gait.mass, held arms and head in the torso) puts the CoM on
 point on the root's x and y, root += (target - CoM) / slope, the slope dCoM/droot measured once per
 walker (~0.8: the torso and most of the legs move with the root, the feet do not) and refined by
 secants; it stops below PLACEMENT_TOLERANCE_M (observed residual ~1e-12 m, docs/balance.md).
-Vectorised over frames (the offline walker); gaitbot.gait.balance.flat_frame is the same for one frame.
+Vectorised over frames (the offline walker); gaitbot.gait.balance.flat_foot_body is the same for one frame.
 
 Turned feet (a steered walk, docs/steering.md): ``yaw`` (n, 2) gives each foot's yaw; the torso (root)
 turns with the mean of the two (torso yaw follows the feet), stays upright, and the legs' IK works in

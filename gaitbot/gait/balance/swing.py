@@ -23,7 +23,7 @@ import numpy as np
 
 from gaitbot.gait.contact import lowest_sole_y
 from gaitbot.gait.geometry import LegGeometry
-from gaitbot.gait.segments import CLEARANCE_WINDOW, StepSegment
+from gaitbot.gait.walk_segments import CLEARANCE_WINDOW, StepSegment
 from gaitbot.gait.walker import WalkSettings, plan_walk
 
 SHAPE_SAMPLES = 201

@@ -15,7 +15,7 @@ For a robot whose legs roll (docs/balance.md):
 
 Online and offline compute the same frames. ``BalancedWalker.next_frame`` runs both preview stages one
 frame at a time (the first one horizon + 1 frame ahead of the output, since the second needs the
-multibody ZMP error over its horizon), placing the body with flat_frame.py's float code;
+multibody ZMP error over its horizon), placing the body with flat_foot_body.py's float code;
 ``generate_balanced_walk`` runs the same recursions over a closed walk, vectorised. Steps appended while
 walking enter the horizon at once: until the walk is closed, the frames beyond the queued steps are the
 close-and-stand that ``finish`` would add (so a walker whose queue runs dry stops safely), and
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gaitbot.gait.balance.flat_frame import FlatFootBody
+from gaitbot.gait.balance.flat_foot_body import FlatFootBody
 from gaitbot.gait.balance.placement import (MAX_PLACEMENT_ITERATIONS, PLACEMENT_TOLERANCE_M, WholeBody,
                                             multibody_zmp, to_world, torso_yaw)
 from gaitbot.gait.balance.preview import PreviewController, preview_gains, preview_offline
@@ -42,7 +42,7 @@ from gaitbot.gait.body import SIDE_SIGN, BodyModel
 from gaitbot.gait.geometry import LegGeometry
 from gaitbot.gait.joints import LEG_JOINTS
 from gaitbot.gait.planning import PlannedStep
-from gaitbot.gait.segments import GaitGenerationError
+from gaitbot.gait.walk_segments import GaitGenerationError
 from gaitbot.gait.trajectory import HeelStrike, Trajectory
 
 STEP_LENGTH_TOLERANCE_M = 1e-12

@@ -1,7 +1,7 @@
 """Eigen-gaits (seed 004): functional PCA of example cycles, and synthesis from coefficients,
 step-length labels, or a required pose. Pure numpy/scipy; I/O only for the model ``.npz``."""
 
-from .examples import ExampleCycle, ExampleError, cycles_from_trajectory, detect_heel_strikes, walk_label
+from .example_cycles import ExampleCycle, ExampleError, cycles_from_trajectory, detect_heel_strikes, walk_label
 from .legs import PlanarLegs, SpatialLegs
 from .model import EigenGaitModel, EigenModelError, FitOptions, fit_model, is_model_file
 from .synth import WalkEnds, root_from_contact, synthesize_cycles, synthesize_walk

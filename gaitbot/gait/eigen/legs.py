@@ -30,7 +30,7 @@ from ..trajectory import HeelStrike, Trajectory, sagittal_to_world
 
 class PlanarLegs:
     """Six pitch joints, the root in the sagittal plane. ``hip_below_root_m`` lifts the root from the hip
-    point to the robot's root, as ``gaitbot generate`` writes it (app/walks.py pelvis_root)."""
+    point to the robot's root, as ``gaitbot generate`` writes it (app/planned_walk.py pelvis_root)."""
 
     root_axes = "xz"
     joints = PITCH_JOINTS

@@ -44,7 +44,7 @@ from ..geometry import LegGeometry
 from ..joints import LEG_JOINTS, PITCH_JOINTS, is_leg_joint
 from .align import align_to_reference, resample_cycle, sample_phases
 from .basis import fit_coefficients, make_basis
-from .examples import ExampleCycle
+from .example_cycles import ExampleCycle
 from .legs import PlanarLegs, SpatialLegs
 from .pose import leading_count, pose_pca
 
@@ -274,89 +274,122 @@ class EigenGaitModel:
 
     @classmethod
     def _from_arrays(cls, d: dict[str, np.ndarray]) -> "EigenGaitModel":
-        def whole(key: str, low: int, high: int) -> int:
-            value = numeric(d, key, 0)
-            if value != np.floor(value) or not low <= value <= high:
-                raise NpzProblem(f"array {key!r} must be a whole number {low}..{high}, got {float(value):g}")
-            return int(value)
-
-        def text(key: str) -> str:
-            if key not in d or d[key].dtype.kind != "U" or d[key].ndim != 0:
-                raise NpzProblem(f"array {key!r} must be one piece of text")
-            return str(d[key])
-
-        def shaped(key: str, shape: tuple, finite: bool = True) -> np.ndarray:
-            value = numeric(d, key, len(shape), finite=finite)
-            if value.shape != shape:
-                raise NpzProblem(f"array {key!r} has shape {value.shape}, expected {shape}")
-            return value
-
-        version = whole("version", 0, 10**6)
+        """The model of a file's arrays, each checked before it is used (NpzProblem names the array)."""
+        a = _ModelArrays(d)
+        version = a.whole("version", 0, 10**6)
         if version not in READ_VERSIONS:
             raise NpzProblem(f"model version {version}, this gaitbot reads {', '.join(map(str, READ_VERSIONS))}")
         joints, root_axes, body_geometry = _joints_and_legs(d, version)
-        n_joints = len(joints)
-        limits = MODEL_LIMITS
-        basis_kind = text("basis_kind")
-        if basis_kind not in ("fourier", "bspline"):
-            raise NpzProblem(f"array 'basis_kind' must be fourier or bspline, got {basis_kind!r}")
-        samples = whole("samples", 8, limits["samples"])
-        n_basis = whole("n_basis", 1, min(samples, limits["n_basis"]))
-        if basis_kind == "fourier" and n_basis % 2 == 0:
-            raise NpzProblem(f"array 'n_basis': a Fourier basis needs an odd number, got {n_basis}")
-        roughness = float(numeric(d, "roughness", 0))
-        if not 0 <= roughness <= MAX_ROUGHNESS:
-            raise NpzProblem(f"array 'roughness' must be 0..{MAX_ROUGHNESS:g}, got {roughness:g}")
-        axes = numeric(d, "pose_axes", 2)
-        dims = axes.shape[1]
-        if axes.shape[0] != n_joints or not 1 <= dims <= n_joints:
-            raise NpzProblem(f"array 'pose_axes' has shape {axes.shape}, expected ({n_joints}, d) with d "
-                             f"1..{n_joints} (one row per joint)")
-        if not np.any(axes):
-            raise NpzProblem("array 'pose_axes' is all zeros: no pose axis to synthesise along")
-        eigen_coefs = numeric(d, "eigen_coefs", 3)
-        m = eigen_coefs.shape[0]
-        if eigen_coefs.shape[1:] != (dims, n_basis) or not 1 <= m <= limits["components"]:
-            raise NpzProblem(f"array 'eigen_coefs' has shape {eigen_coefs.shape}, expected (M, {dims}, {n_basis}) "
-                             f"with M 1..{limits['components']}")
-        scores = numeric(d, "scores", 2)
-        n = scores.shape[0]
-        if scores.shape[1] != m or not 1 <= n <= limits["examples"]:
-            raise NpzProblem(f"array 'scores' has shape {scores.shape}, expected (N, {m}) with N 1..{limits['examples']}")
-        geometry = shaped("geometry", (6,))
-        if not (np.all(geometry[:4] > 0) and np.all(geometry[4:] >= 0) and np.all(geometry <= 2.0)):
-            raise NpzProblem("array 'geometry' must hold thigh, shank, foot, hip width (positive), ankle height and "
-                             "heel back (0 or more), each at most 2 m")
-        rate_hz = float(numeric(d, "rate_hz", 0))
-        if not 1.0 <= rate_hz <= 1000.0:
-            raise NpzProblem(f"array 'rate_hz' must be a frame rate of 1..1000 Hz, got {rate_hz:g}")
-        if "sources" not in d:
-            raise NpzProblem("missing array 'sources'")
-        sources = d["sources"]
-        if sources.dtype.kind not in "U" or sources.ndim != 1:
-            raise NpzProblem("array 'sources' must be a list of file names (text)")
-        residuals = d.get("pose_residuals_deg")
-        if residuals is not None:
-            residuals = numeric(d, "pose_residuals_deg", 1, finite=False)
-            if residuals.shape not in ((0,), (n_joints,)):
-                raise NpzProblem(f"array 'pose_residuals_deg' has shape {residuals.shape}, expected ({n_joints},)")
-        variance_dims = whole("pose_variance_dims", 0, n_joints) if "pose_variance_dims" in d else 0
-        durations = shaped("durations_s", (n,))
-        if not np.all((durations >= 0.2) & (durations <= 10.0)):
-            raise NpzProblem("array 'durations_s' must hold cycle durations of 0.2..10 s")
-        labels = shaped("labels", (n,))
-        if not np.all((labels >= 0) & (labels <= 2.0)):
-            raise NpzProblem("array 'labels' must hold step lengths of 0..2 m")
-        phases = shaped("right_strike_phases", (n,))
-        if not np.all((phases > 0) & (phases < 1)):
-            raise NpzProblem("array 'right_strike_phases' must hold phases between 0 and 1")
-        return cls(basis_kind, n_basis, samples, bool(numeric(d, "periodic", 0)), roughness,
-                   shaped("pose_mean", (n_joints,)), axes, shaped("pose_eigenvalues", (n_joints,)),
-                   shaped("coef_mean", (dims, n_basis)), eigen_coefs, shaped("eigenvalues", (m,)),
-                   whole("n_components", 1, m), scores, labels, shaped("warp_coefs", (n, n_basis)),
-                   durations, phases, whole("label_degree", 0, 10),
-                   LegGeometry(*map(float, geometry)), rate_hz, tuple(str(x) for x in sources),
-                   variance_dims, residuals, text("robot") if "robot" in d else "", joints, root_axes, body_geometry)
+        basis = _basis_fields(a)
+        motion = _motion_fields(a, len(joints), basis["n_basis"])
+        examples = _example_fields(a, len(joints), motion["scores"].shape[0])
+        dims, m, n = motion["pose_axes"].shape[1], motion["eigen_coefs"].shape[0], motion["scores"].shape[0]
+        return cls(**basis, **motion, **examples, periodic=bool(numeric(d, "periodic", 0)),
+                   pose_mean=a.shaped("pose_mean", (len(joints),)),
+                   pose_eigenvalues=a.shaped("pose_eigenvalues", (len(joints),)),
+                   coef_mean=a.shaped("coef_mean", (dims, basis["n_basis"])), eigenvalues=a.shaped("eigenvalues", (m,)),
+                   n_components=a.whole("n_components", 1, m),
+                   warp_coefs=a.shaped("warp_coefs", (n, basis["n_basis"])),
+                   label_degree=a.whole("label_degree", 0, 10), robot=a.text("robot") if "robot" in d else "",
+                   joints=joints, root_axes=root_axes, body_geometry=body_geometry)
+
+
+class _ModelArrays:
+    """A model file's arrays, read one at a time with the check its use needs."""
+
+    def __init__(self, arrays: dict[str, np.ndarray]) -> None:
+        self.d = arrays
+
+    def whole(self, key: str, low: int, high: int) -> int:
+        value = numeric(self.d, key, 0)
+        if value != np.floor(value) or not low <= value <= high:
+            raise NpzProblem(f"array {key!r} must be a whole number {low}..{high}, got {float(value):g}")
+        return int(value)
+
+    def text(self, key: str) -> str:
+        if key not in self.d or self.d[key].dtype.kind != "U" or self.d[key].ndim != 0:
+            raise NpzProblem(f"array {key!r} must be one piece of text")
+        return str(self.d[key])
+
+    def shaped(self, key: str, shape: tuple, finite: bool = True) -> np.ndarray:
+        value = numeric(self.d, key, len(shape), finite=finite)
+        if value.shape != shape:
+            raise NpzProblem(f"array {key!r} has shape {value.shape}, expected {shape}")
+        return value
+
+
+def _basis_fields(a: _ModelArrays) -> dict:
+    """The basis the model's curves are written in: its kind, size, samples per cycle and roughness."""
+    limits = MODEL_LIMITS
+    basis_kind = a.text("basis_kind")
+    if basis_kind not in ("fourier", "bspline"):
+        raise NpzProblem(f"array 'basis_kind' must be fourier or bspline, got {basis_kind!r}")
+    samples = a.whole("samples", 8, limits["samples"])
+    n_basis = a.whole("n_basis", 1, min(samples, limits["n_basis"]))
+    if basis_kind == "fourier" and n_basis % 2 == 0:
+        raise NpzProblem(f"array 'n_basis': a Fourier basis needs an odd number, got {n_basis}")
+    roughness = float(numeric(a.d, "roughness", 0))
+    if not 0 <= roughness <= MAX_ROUGHNESS:
+        raise NpzProblem(f"array 'roughness' must be 0..{MAX_ROUGHNESS:g}, got {roughness:g}")
+    return {"basis_kind": basis_kind, "n_basis": n_basis, "samples": samples, "roughness": roughness}
+
+
+def _motion_fields(a: _ModelArrays, n_joints: int, n_basis: int) -> dict:
+    """The pose axes, the eigen-motions and the examples' scores on them (their shapes fix d, M and N)."""
+    limits = MODEL_LIMITS
+    axes = numeric(a.d, "pose_axes", 2)
+    dims = axes.shape[1]
+    if axes.shape[0] != n_joints or not 1 <= dims <= n_joints:
+        raise NpzProblem(f"array 'pose_axes' has shape {axes.shape}, expected ({n_joints}, d) with d "
+                         f"1..{n_joints} (one row per joint)")
+    if not np.any(axes):
+        raise NpzProblem("array 'pose_axes' is all zeros: no pose axis to synthesise along")
+    eigen_coefs = numeric(a.d, "eigen_coefs", 3)
+    m = eigen_coefs.shape[0]
+    if eigen_coefs.shape[1:] != (dims, n_basis) or not 1 <= m <= limits["components"]:
+        raise NpzProblem(f"array 'eigen_coefs' has shape {eigen_coefs.shape}, expected (M, {dims}, {n_basis}) "
+                         f"with M 1..{limits['components']}")
+    scores = numeric(a.d, "scores", 2)
+    n = scores.shape[0]
+    if scores.shape[1] != m or not 1 <= n <= limits["examples"]:
+        raise NpzProblem(f"array 'scores' has shape {scores.shape}, expected (N, {m}) with N 1..{limits['examples']}")
+    return {"pose_axes": axes, "eigen_coefs": eigen_coefs, "scores": scores}
+
+
+def _example_fields(a: _ModelArrays, n_joints: int, n: int) -> dict:
+    """The leg, the frame rate, the example files and what the fit measured of each example."""
+    d = a.d
+    geometry = a.shaped("geometry", (6,))
+    if not (np.all(geometry[:4] > 0) and np.all(geometry[4:] >= 0) and np.all(geometry <= 2.0)):
+        raise NpzProblem("array 'geometry' must hold thigh, shank, foot, hip width (positive), ankle height and "
+                         "heel back (0 or more), each at most 2 m")
+    rate_hz = float(numeric(d, "rate_hz", 0))
+    if not 1.0 <= rate_hz <= 1000.0:
+        raise NpzProblem(f"array 'rate_hz' must be a frame rate of 1..1000 Hz, got {rate_hz:g}")
+    if "sources" not in d:
+        raise NpzProblem("missing array 'sources'")
+    sources = d["sources"]
+    if sources.dtype.kind not in "U" or sources.ndim != 1:
+        raise NpzProblem("array 'sources' must be a list of file names (text)")
+    residuals = d.get("pose_residuals_deg")
+    if residuals is not None:
+        residuals = numeric(d, "pose_residuals_deg", 1, finite=False)
+        if residuals.shape not in ((0,), (n_joints,)):
+            raise NpzProblem(f"array 'pose_residuals_deg' has shape {residuals.shape}, expected ({n_joints},)")
+    variance_dims = a.whole("pose_variance_dims", 0, n_joints) if "pose_variance_dims" in d else 0
+    durations = a.shaped("durations_s", (n,))
+    if not np.all((durations >= 0.2) & (durations <= 10.0)):
+        raise NpzProblem("array 'durations_s' must hold cycle durations of 0.2..10 s")
+    labels = a.shaped("labels", (n,))
+    if not np.all((labels >= 0) & (labels <= 2.0)):
+        raise NpzProblem("array 'labels' must hold step lengths of 0..2 m")
+    phases = a.shaped("right_strike_phases", (n,))
+    if not np.all((phases > 0) & (phases < 1)):
+        raise NpzProblem("array 'right_strike_phases' must hold phases between 0 and 1")
+    return {"geometry": LegGeometry(*map(float, geometry)), "rate_hz": rate_hz,
+            "sources": tuple(str(x) for x in sources), "pose_variance_dims": variance_dims,
+            "pose_residuals_deg": residuals, "durations_s": durations, "labels": labels,
+            "right_strike_phases": phases}
 
 
 def _joints_and_legs(d: dict[str, np.ndarray], version: int) -> tuple[tuple, str, BodyGeometry | None]:
@@ -482,11 +515,12 @@ def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: floa
         m = options.components
     else:
         m = leading_count(eigenvalues, options.motion_variance)
-    return EigenGaitModel(options.basis, K, options.samples, periodic, options.roughness, pose_mean, axes,
-                          pose.eigenvalues,
-                          coef_mean, b.reshape(-1, d, K), eigenvalues, m, scores, labels, warp_coefs,
-                          np.array([e.duration_s for e in examples]),
-                          np.array([e.right_strike_phase for e in examples]), options.label_degree, geometry,
-                          float(rate_hz), tuple(sorted({e.source for e in examples})), pose.variance_dims,
-                          pose.residuals_deg, robot, tuple(legs.joints), legs.root_axes,
-                          getattr(legs, "body_geometry", None))
+    return EigenGaitModel(
+        basis_kind=options.basis, n_basis=K, samples=options.samples, periodic=periodic, roughness=options.roughness,
+        pose_mean=pose_mean, pose_axes=axes, pose_eigenvalues=pose.eigenvalues, coef_mean=coef_mean,
+        eigen_coefs=b.reshape(-1, d, K), eigenvalues=eigenvalues, n_components=m, scores=scores, labels=labels,
+        warp_coefs=warp_coefs, durations_s=np.array([e.duration_s for e in examples]),
+        right_strike_phases=np.array([e.right_strike_phase for e in examples]), label_degree=options.label_degree,
+        geometry=geometry, rate_hz=float(rate_hz), sources=tuple(sorted({e.source for e in examples})),
+        pose_variance_dims=pose.variance_dims, pose_residuals_deg=pose.residuals_deg, robot=robot,
+        joints=tuple(legs.joints), root_axes=legs.root_axes, body_geometry=getattr(legs, "body_geometry", None))

@@ -10,7 +10,7 @@ Choices (stated once):
   (the correction is the difference between the walker's and the model's pose and velocity at
   the join, so it is small when the model is accurate). The default, a tenth of a cycle, keeps
   the correction inside the first and last 20% of the step next to each join, outside the part of
-  the swing where the walker's clearance rule holds (segments.CLEARANCE_WINDOW): fading over a
+  the swing where the walker's clearance rule holds (walk_segments.CLEARANCE_WINDOW): fading over a
   quarter cycle instead took the last synthesised swing 7 mm lower, below the configured clearance.
 - Transitions: the label (or the coefficients) is interpolated linearly from cycle to cycle, and
   within a cycle the coefficients go linearly from the cycle's start value to its end value, so
@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..footfall import root_from_contact  # noqa: F401  (the planar contact rule; legs.py uses it)
-from ..segments import CLEARANCE_WINDOW
+from ..walk_segments import CLEARANCE_WINDOW
 from ..geometry import LegGeometry
 from ..trajectory import Trajectory
 from .model import EigenGaitModel, EigenModelError

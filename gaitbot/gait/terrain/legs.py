@@ -15,7 +15,7 @@ from functools import cached_property
 import numpy as np
 
 from ..geometry import LegGeometry, leg_ik
-from ..segments import MIN_KNEE_RAD, crouch_leg_scale
+from ..walk_segments import MIN_KNEE_RAD, crouch_leg_scale
 
 FREE_KNEE_RAD = np.radians(150.0)  # the knee's bend when no joint ranges are given
 MOTION_SHARE = 0.8  # plans keep joint speeds and accelerations below this share of the limits (samples are sparse)

@@ -14,7 +14,7 @@ A step runs from one heel strike to the next, in two parts of its progress u:
   lets the leading leg land on a higher or farther tread without bending its hip past its range.
   The foot comes to rest on its toe at the heel strike and goes on rolling in the next step.
 
-The pelvis is not this module's: ``run.py`` builds one path for a run of consecutive terrain
+The pelvis is not this module's: ``run_pelvis.py`` builds one path for a run of consecutive terrain
 steps and hands it over (``pelvis``); then ``evaluate`` gives every leg angle by 2-link IK.
 """
 
@@ -24,7 +24,7 @@ import numpy as np
 
 from ..contact import grounded_ankle, heel_pinned_ankle
 from ..geometry import leg_ik
-from ..segments import GaitContext, GaitGenerationError, WalkState, flat_pause, flat_pause_inverse, flat_pause_slope
+from ..walk_segments import GaitContext, GaitGenerationError, WalkState, flat_pause, flat_pause_inverse, flat_pause_slope
 from ..smooth import hermite_segment, smootherstep
 from .footholds import Foothold
 from .legs import LegRange

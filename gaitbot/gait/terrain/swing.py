@@ -43,7 +43,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..geometry import LegGeometry, foot_points, leg_ik
-from ..segments import GaitGenerationError
+from ..walk_segments import GaitGenerationError
 from ..smooth import plateau, smootherstep, smoothstep
 from .model import Terrain
 

@@ -3,7 +3,7 @@
 Steps whose three footholds (rear, stance, target) lie on one surface with no edge between
 are the flat walker's ``StepSegment`` (the Boulic style), lifted to that surface's height by
 ``LevelSegment``. Every other step is a ``TerrainStepSegment`` (step.py: feet in the world,
-swing.py: the swing foot's path), and consecutive terrain steps form a ``TerrainRun`` (run.py:
+swing.py: the swing foot's path), and consecutive terrain steps form a ``TerrainRun`` (run_pelvis.py:
 seed 003's Bezier pelvis through MS and MDS points, the MDS points chosen by the two-level grid
 search). Every leg angle of a terrain step comes from 2-link IK, pelvis to ankle.
 
@@ -22,13 +22,13 @@ import numpy as np
 
 from ..contact import grounded_ankle
 from ..geometry import LegGeometry
-from ..segments import CrouchSegment, GaitContext, GaitGenerationError, SettleSegment, StepSegment, WalkState
+from ..walk_segments import CrouchSegment, GaitContext, GaitGenerationError, SettleSegment, StepSegment, WalkState
 from ..trajectory import HeelStrike, Trajectory
 from .envelope import StepEnvelope
 from .footholds import Foothold, FootholdLimits, plan_footholds
 from .legs import LegRange
 from .model import Terrain
-from .run import MdsProblem, TerrainRun
+from .run_pelvis import MdsProblem, TerrainRun
 from .search import SearchResult
 from .step import TerrainStepSegment
 

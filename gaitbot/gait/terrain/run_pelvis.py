@@ -26,7 +26,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..segments import GaitContext, GaitGenerationError, crouch_leg_scale
+from ..walk_segments import GaitContext, GaitGenerationError, crouch_leg_scale
 from .legs import LegRange
 from .pelvis import Knot, PelvisPath
 from .search import Region, SearchResult, brute_force, two_level_search
