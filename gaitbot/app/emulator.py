@@ -107,6 +107,11 @@ def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
     if not args.voltage_sag >= 0:
         raise ValueError(f"--voltage-sag must be 0 or more volts per second, got {args.voltage_sag}")
     config.supply_v, config.voltage_sag_v_per_s = args.supply_v, args.voltage_sag
+    numbers = _id_numbers(args.model_number, "--model-number", 0, 65535, "(a model number)")
+    absent = sorted(set(numbers) - set(config.models))
+    if absent:
+        raise ValueError(f"--model-number: servo {', '.join(map(str, absent))} is not on the chain")
+    config.model_numbers = {servo_id: int(number) for servo_id, number in numbers.items()}
     if args.one_at_a_time and not config.fresh:
         raise ValueError("--one-at-a-time needs --factory-fresh (a chain of new servos, connected one by one)")
     config.one_at_a_time = args.one_at_a_time
@@ -228,6 +233,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "e.g. 12.0 V for X and AX, 7.4 V for STS3215)")
     p.add_argument("--voltage-sag", type=float, default=0.0, metavar="V_PER_S",
                    help="the supply falls this many volts per second once faults start (--fault-after-*)")
+    p.add_argument("--model-number", action="append", metavar="ID:NUMBER", help="this servo reports this model "
+                   "number (ping and its Model Number register), e.g. 3:1060 for an XL430-W250 among XM430s")
     return p
 
 

@@ -9,6 +9,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from gaitbot.servos import model_name_of
 from gaitbot.servos.health import HealthReading
 from gaitbot.servos.registers import RegisterWrite
 
@@ -55,6 +56,24 @@ class ServoStatusError(BusError):
     def __init__(self, message: str, *, fault: str = "", **kwargs) -> None:
         super().__init__(message, **kwargs)
         self.fault = fault
+
+
+class WrongServoModel(BusError):
+    """Servos that answered with another model number than their configured model's: ``wrong`` lists
+    (servo id, model number found). Raised before anything is written, so a servo of another model is
+    never driven with the configured model's gains, limits and thresholds."""
+
+    def __init__(self, wrong, models, backend: str, port_name: str) -> None:
+        self.wrong = [(int(i), int(n)) for i, n in wrong]
+        parts = []
+        for servo_id, number in self.wrong:
+            expected = models[servo_id]
+            found = model_name_of(backend, number) or "a model gaitbot does not know"
+            parts.append(f"servo {servo_id} is a {found} (model number {number}), the config expects a "
+                         f"{expected.name} (model number {expected.model_number})")
+        super().__init__(f"wrong servo model on {port_name}: {'; '.join(parts)}; nothing was written "
+                         "(fit the configured servo, or describe the robot's real servos in its config)",
+                         servo_id=self.wrong[0][0])
 
 
 @dataclass(frozen=True)
@@ -156,4 +175,4 @@ class Bus(ABC):
 
 
 __all__ = ["Bus", "HealthReading", "BusError", "ReadBack", "PortError", "ServoTimeout", "ServoLate", "CorruptReplies",
-           "ServoStatusError", "RegisterWrite"]
+           "ServoStatusError", "RegisterWrite", "WrongServoModel"]

@@ -3,7 +3,8 @@ what a servo says about itself (gaitbot setup, gaitbot scan). The people's side 
 gaitbot/app/setup.py and scan.py; docs/bring-up.md tells the whole story.
 
 Giving a servo its id and baud rate (:func:`assign_id_and_baud`) writes exactly these registers, in this
-order, and nothing else (vendor-facts.md section 7; LeRobot's ``setup_motor`` does the same):
+order, and nothing else (the e-Manual's "ID" and "Baud Rate" control-table entries; LeRobot's
+``setup_motor`` does the same):
 
 1. Torque Enable = 0 (EEPROM is writable only with torque off on Dynamixel; Feetech is not documented
    either way, so it is done there too), confirmed;

@@ -208,6 +208,7 @@ class EmulatorConfig:
     temperatures_c: dict[int, float] = field(default_factory=dict)  # servo id -> temperature at the start
     supply_v: float | None = None  # None: the first servo's usual supply (its Present Voltage factory value)
     voltage_sag_v_per_s: float = 0.0  # the supply falls this fast once faults are active
+    model_numbers: dict[int, int] = field(default_factory=dict)  # servo id -> the model number it reports
 
 
 class EmulatedChain(MockPort):
@@ -262,6 +263,10 @@ class EmulatedChain(MockPort):
         units = []
         for index, (servo_id, model) in enumerate(entries):
             table = MockPort.initial_table(model, servo_id, None if fresh else config.baudrate)
+            if servo_id in config.model_numbers and not fresh:  # a servo of another model behind this one's table
+                number = model.control_table["Model Number"]
+                table[number.address:number.address + number.size] = \
+                    config.model_numbers[servo_id].to_bytes(number.size, model.byte_order)
             layout = LAYOUTS[model.name]
             if config.return_delay_us is not None:
                 table[layout.return_delay_addr] = min(254, int(round(config.return_delay_us / 2)))

@@ -197,9 +197,9 @@ class MockPort:
         for servo_id in self._targets(frame.packet_id):
             extra = b""
             if self.framing == "v2":  # Protocol 2.0 ping: model number (2 bytes) and firmware version
-                model = self.models[servo_id]
-                firmware = self.tables[servo_id][model.control_table["Firmware Version"].address]
-                extra = bytes([model.model_number & 0xFF, model.model_number >> 8, firmware])
+                table, registers = self.tables[servo_id], self.models[servo_id].control_table
+                number = registers["Model Number"].address
+                extra = bytes(table[number:number + 2]) + bytes([table[registers["Firmware Version"].address]])
             self._reply(servo_id, extra)
 
     def _read(self, frame: wire.Frame) -> None:

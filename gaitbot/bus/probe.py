@@ -31,7 +31,7 @@ from typing import Any
 
 from gaitbot.bus.base import PortError, ServoTimeout
 from gaitbot.bus.sdk_bus import PORT_EXCEPTIONS, is_pseudo_terminal
-from gaitbot.servos import control_table, max_servo_id, vendor, wire
+from gaitbot.servos import control_table, max_servo_id, model_name_of, vendor, wire
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
 
 #: dynamixel_sdk's broadcastPing window: status packets of 14 bytes from every id, 3 ms a servo, 16 ms latency.
@@ -67,14 +67,6 @@ class ProbeResult:
     baudrate: int
     found: list[ServoFound] = field(default_factory=list)
     damaged: int = 0
-
-
-def model_name_of(backend: str, number: int) -> str | None:
-    """The model with this model number on a ``backend`` bus (None: gaitbot does not know it)."""
-    for name, known in vendor(backend).MODEL_NUMBERS.items():
-        if known == number:
-            return name
-    return None
 
 
 class ProbeBus:

@@ -14,7 +14,7 @@ from types import ModuleType
 from typing import Any
 
 from gaitbot.bus.base import (Bus, BusError, CorruptReplies, PortError, ReadBack, ServoLate, ServoStatusError,
-                              ServoTimeout)
+                              ServoTimeout, WrongServoModel)
 from gaitbot.bus.log import RecordingFailed
 from gaitbot.servos import dynamixel, has_sync_read, max_servo_id, wire
 from gaitbot.servos.health import HealthReading, decode_health, health_block
@@ -203,16 +203,19 @@ class SdkBus(Bus):
 
     @contextmanager
     def _port_guard(self, servo_id: int | None = None) -> Iterator[None]:
-        """Turn an OS-level failure of the port inside the SDK into PortError (never retried)."""
+        """One transaction with the SDK: an OS-level failure of the port becomes PortError (never retried),
+        and the SDK's port lock is released however the block ends (issue 26: a KeyboardInterrupt or
+        SIGTERM landing between the SDK taking its lock and giving it back must not leave every later
+        packet, the stop ramp's included, refused as "Port is in use!")."""
         try:
             yield
         except RecordingFailed:  # the recorder under the port failed, not the port: the bus goes on
-            self._release_port()
             raise
         except PORT_EXCEPTIONS as exc:
-            self._release_port()
             raise PortError(f"serial port {self.port_name} failed: {exc} (the adapter was unplugged or the "
                             "port closed)", servo_id=servo_id) from exc
+        finally:
+            self._release_port()
 
     def _release_port(self) -> None:
         try:
@@ -242,6 +245,17 @@ class SdkBus(Bus):
         if late:
             raise self._late(servo_id, f"to {late} of {1 + self.retries} pings")
         return False
+
+    def scan(self, ids: Iterable[int]) -> list[int]:
+        """The ids among ``ids`` that answer a ping; WrongServoModel when a configured servo that answered
+        reports another model number than its configured model's (the ping read it: nothing is written)."""
+        answering = super().scan(ids)
+        wrong = [(i, self.model_numbers[i]) for i in answering
+                 if i in self.models and self.model_numbers.get(i, self.models[i].model_number)
+                 != self.models[i].model_number]
+        if wrong:
+            raise WrongServoModel(wrong, self.models, self.family, self.port_name)
+        return answering
 
     def set_torque(self, ids: Iterable[int], enabled: bool) -> None:
         """Write Torque Enable to each servo and wait for its status packet.
@@ -403,16 +417,12 @@ class SdkBus(Bus):
         self._before_transaction()
         with self._port_guard(servo_id):
             self._drop_stale_input()
-            result = self._ph.readTx(self.port, servo_id, address, length)
+            result = self._ph.readTx(self.port, servo_id, address, length)  # takes the lock the guard releases
             if result != self.sdk.COMM_SUCCESS:
-                self.port.is_using = False
                 self._raise_on_port_failure(result, servo_id)
                 return "missed", None
             remaining_ms = max(0.0, budget_s - (time.monotonic() - start_s)) * 1000.0
-            try:
-                return self._await_status(servo_id, length, remaining_ms)
-            finally:
-                self.port.is_using = False  # readTx took the SDK's lock; no rxPacket of the SDK releases it
+            return self._await_status(servo_id, length, remaining_ms)
 
     def _await_status(self, servo_id: int, length: int, timeout_ms: float) -> tuple[str, wire.Frame | None]:
         framing = wire.framing_for(self.family, self.protocol)

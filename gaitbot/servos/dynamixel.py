@@ -22,8 +22,8 @@ MODEL_NUMBERS = {"XL430-W250": 1060, "XM430-W350": 1020, "XL-320": 350, "AX-12A"
 #: Every Dynamixel leaves the factory at id 1 (e-Manual Protocol 1.0 / 2.0, "ID": "the default ID ... is 1").
 FACTORY_ID = 1
 
-# Control tables from the e-Manual (ROBOTIS-GIT/emanual docs/en/dxl/x/xl430-w250.md, xm430-w350.md,
-# xl320.md, ax/ax-12a.md; /work/proto/facts/vendor-facts.md section 2). ``factory`` is the value as shipped
+# Control tables from the ROBOTIS e-Manual pages "XL430-W250", "XM430-W350", "XL-320" and "AX-12/AX-12A"
+# (emanual.robotis.com, section "Control Table"). ``factory`` is the value as shipped
 # for settings; for the Present registers it is the value the emulator starts from (not a vendor fact).
 # X series (XL430-W250, XM430-W350): EEPROM 0..63, RAM from 64 (EEPROM writable only with torque off).
 _X_SERIES: ControlTable = {

@@ -21,8 +21,8 @@ MODEL_NUMBERS = {"STS3215": 777, "SCS0009": 1284}
 #: Feetech servos leave the factory at id 1 (SMS/STS and SCSCL memory tables, "ID" initial value 1).
 FACTORY_ID = 1
 
-# The SMS/STS memory table (Feetech wiki ftservo-wiki docs/en/reference/parameter/memory-sts.md, cross-checked
-# with Feetech's SMS_STS.h and LeRobot's tables.py; /work/proto/facts/vendor-facts.md 2.4): EEPROM 0..39,
+# Feetech's "SMS/STS series memory table" (its servo wiki, "Memory table" page; cross-checked with Feetech's
+# SMS_STS.h and LeRobot's tables.py): EEPROM 0..39,
 # RAM from 40. ``factory`` of a Present register is the emulator's starting value, not a vendor fact.
 _SERIES: ControlTable = {
     "Firmware Major Version": Register(0, 1, 3), "Firmware Minor Version": Register(1, 1, 9),
@@ -44,7 +44,7 @@ _SERIES: ControlTable = {
 # The SCS0009's factory P coefficient is not known (the SCS15 manual gives 15), so it is not emulated.
 STS3215: ControlTable = {**_SERIES, "P Coefficient": Register(21, 1, 32), "Max Position Limit": Register(11, 2, 4095),
                          "Max Voltage Limit": Register(14, 1, 140), "Present Voltage": Register(62, 1, 74)}
-# SCSCL memory table (memory-scscl.md): the same addresses but the Lock flag at 48, big-endian words.
+# Feetech's "SCSCL series memory table": the same addresses but the Lock flag at 48, big-endian words.
 SCS0009: ControlTable = {**_SERIES, "Max Position Limit": Register(11, 2, 1023),
                          "Max Voltage Limit": Register(14, 1, 80), "Present Voltage": Register(62, 1, 60),
                          "Lock": Register(48, 1, 1), "Byte Order": Register(2, 1, 1)}
@@ -52,7 +52,7 @@ CONTROL_TABLES = {"STS3215": STS3215, "SCS0009": SCS0009}
 #: First RAM address (memory tables: EEPROM 0..39, SRAM from 40).
 EEPROM_END = {"STS3215": 40, "SCS0009": 40}
 #: Baud Rate(6) value -> bits per second (Feetech's SMS/STS and SCSCL tables and SMS_STS.h, factory 0 = 1 Mbps;
-#: LeRobot's table differs at 5..7 and is not followed, see vendor-facts.md section 3).
+#: LeRobot's table differs at 5..7 and is not followed: Feetech's own table and SMS_STS.h agree).
 _BAUD_RATES = {0: 1_000_000, 1: 500_000, 2: 250_000, 3: 128_000, 4: 115_200, 5: 76_800, 6: 57_600, 7: 38_400}
 BAUD_RATES = {"STS3215": _BAUD_RATES, "SCS0009": _BAUD_RATES}
 
