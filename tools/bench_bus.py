@@ -4,7 +4,7 @@ For each protocol, 6 and 12 servos: the real DynamixelBus / FeetechBus (vendor S
 the emulator's pty, gaitbot.bus.emulator on a thread, factory Return Delay Time) sends frames
 back to back for ``--seconds``: goal sync writes only, then a sync write plus a read of every
 servo (sync read where the protocol has one). Beside it, the wire limit from the packet sizes
-(gaitbot.bus.budget.frame_budget: 10 bits a byte, plus one return delay per status packet) at
+(gaitbot.servos.budget.frame_budget: 10 bits a byte, plus one return delay per status packet) at
 1 Mbaud and at 57,600 baud, without the 30 % margin the config check keeps.
 
     python tools/bench_bus.py              # about 20 s
@@ -24,10 +24,10 @@ import sys
 import time
 
 try:
-    from gaitbot.bus.budget import frame_budget
+    from gaitbot.servos.budget import frame_budget
 except ImportError:  # run from a checkout without installing
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
-    from gaitbot.bus.budget import frame_budget
+    from gaitbot.servos.budget import frame_budget
 
 from gaitbot.app.emulator import PROTOCOLS
 from gaitbot.bus import emulator as se
