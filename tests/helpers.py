@@ -41,9 +41,9 @@ def gaitbot(*args: str, timeout: float = WALK_TIMEOUT_S) -> subprocess.Completed
 
 
 def emulator_for(config_path: Path, log_path: Path, faults=None, model_numbers=None):
-    """The servo emulator (gaitbot.bus.emulator) of a robot config on a pty, logging the goals it receives;
+    """The servo emulator (gaitbot.emulator) of a robot config on a pty, logging the goals it receives;
     ``model_numbers`` (servo id -> number): servos that report another model number than their model's."""
-    from gaitbot.bus import emulator as se
+    import gaitbot.emulator as se
 
     robot = load_robot_config(config_path)
     return se.ServoEmulator(se.EmulatorConfig(

@@ -1,4 +1,4 @@
-"""The servo emulator's command line (``python tools/servo_emulator.py``; the engine is gaitbot.bus.emulator).
+"""The servo emulator's command line (``python tools/servo_emulator.py``; the engine is gaitbot.emulator).
 
 Opens a pty pair, prints the device path (the end a driver opens) as the first line of its output,
 and answers on it like a chain of servos until Ctrl-C:
@@ -22,8 +22,9 @@ import math
 import sys
 
 from gaitbot.app.cli import OneLineParser
-from gaitbot.bus.emulator import (FAULT_KINDS, EmulatorConfig, Faults, Heat, ServoEmulator, hand_from_ticks,
-                                  hand_from_trajectory)
+from gaitbot.emulator import FAULT_KINDS, EmulatorConfig, Faults, Hand, Heat, ServoEmulator, hand_from_ticks
+from gaitbot.gait.trajectory import Trajectory
+from gaitbot.robot.calibration import trajectory_ticks
 from gaitbot.robot.calibration_file import load_robot_with_calibration
 from gaitbot.servos import baud_rates, baud_register_value
 from gaitbot.servos.models import servo_model
@@ -92,6 +93,19 @@ def _id_numbers(items, flag: str, low: float, high: float, unit: str) -> dict[in
             raise ValueError(f"{flag} {item!r}: the value must be within {low:g}..{high:g} {unit}")
         out[servo_id] = number
     return out
+
+
+def hand_from_trajectory(robot, path: str, rate_hz: float | None = None) -> Hand:
+    """A hand playing a trajectory file (.csv/.npz): its angles through the robot's calibration, held
+    joints at their hold angle (the emulator room knows no gait: it is given the ticks). Ticks outside a
+    servo's encoder range cannot be reported: refused."""
+    ticks = trajectory_ticks(robot, Trajectory.load(path))
+    for column, joint in enumerate(robot.joints):
+        low, high = int(ticks[:, column].min()), int(ticks[:, column].max())
+        if low < joint.model.min_tick or high > joint.model.max_tick:
+            raise ValueError(f"--hand {path}: {joint.name} goes to ticks {low}..{high}, outside the "
+                             f"{joint.model.name}'s {joint.model.min_tick}..{joint.model.max_tick}")
+    return Hand({joint.id: ticks[:, column].tolist() for column, joint in enumerate(robot.joints)}, rate_hz)
 
 
 def config_from_args(args: argparse.Namespace) -> EmulatorConfig:

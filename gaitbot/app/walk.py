@@ -14,7 +14,7 @@ from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeo
 from gaitbot.app.progress import callback, progress
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
-from gaitbot.bus.log import BusRecorder, RecordingFailed
+from gaitbot.bus.recording import BusRecorder, RecordingFailed
 from gaitbot.check.preflight import preflight
 from gaitbot.errors import UserError
 from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
@@ -97,7 +97,7 @@ def run(args) -> int:
             bus = guarded(config, sim.make_bus(clock.now, recorder))
         else:
             bus = make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,
-                                 reply_timeout_ms=args.reply_timeout_ms)
+                                 reply_timeout_ms=args.reply_timeout_ms, clock=clock.now)
     except (OSError, RecordingFailed) as exc:
         if recorder is None:
             raise
@@ -123,7 +123,7 @@ def run(args) -> int:
     finally:
         if recorder is not None:
             recorder.close()
-    for note in getattr(bus, "open_notes", []):
+    for note in bus.open_notes:
         print(f"note: {note}", file=sys.stderr)
     if sim is not None and args.json:
         return _sim_exit(_sim_report(sim, True, result.outcome, args.video), result.exit_code)

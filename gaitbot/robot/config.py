@@ -35,7 +35,7 @@ from gaitbot.gait.walker import WalkSettings, make_context
 from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
 from gaitbot.robot.gains import GainError, gain_for_error
 from gaitbot.robot.health import HealthSettings, read_health
-from gaitbot.servos import BACKENDS, dynamixel, feetech, max_servo_id, vendor
+from gaitbot.servos import BACKENDS, feetech, max_servo_id, vendor
 from gaitbot.servos.budget import FrameBudget, check_rate
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
 
@@ -543,13 +543,14 @@ class _Reader(Fields):
         backend = self.string(t, "backend", f, f"one of {', '.join(map(repr, BACKENDS))}")
         if backend not in BACKENDS:
             raise self.fail("bus.backend", f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
-        protocol = feetech.PROTOCOLS[0]
-        if backend == "dynamixel":
-            allowed = " or ".join(str(p) for p in dynamixel.PROTOCOLS)
+        protocols = vendor(backend).PROTOCOLS
+        protocol = protocols[0]
+        if len(protocols) > 1:
+            allowed = " or ".join(str(p) for p in protocols)
             protocol = self.number(t, "protocol", f)
-            if protocol not in dynamixel.PROTOCOLS:
-                raise self.fail("bus.protocol", f"unknown Dynamixel protocol {protocol} (allowed: {allowed})")
-        # Feetech servos speak one protocol; a protocol key there is accepted and ignored (always 1.0).
+            if protocol not in protocols:
+                raise self.fail("bus.protocol", f"unknown {backend.capitalize()} protocol {protocol} (allowed: {allowed})")
+        # A vendor whose servos speak one protocol (Feetech): a protocol key is accepted and ignored (always 1.0).
         port = self.string(t, "port", f, "a serial port name, e.g. '/dev/ttyUSB0' or 'COM3'")
         rates = vendor(backend).SDK_BAUDRATES
         allowed_rates = ", ".join(str(r) for r in rates)

@@ -13,8 +13,16 @@ NAME = "feetech"
 PROTOCOLS = (1.0,)  # the one (Dynamixel-1.0-shaped) protocol Feetech servos speak
 BROADCAST_ID = 0xFE
 MAX_ID = {1.0: 253}
+#: scservo_sdk's PortHandler.clearPort only flushes output: pending input stays (the dry-run port behaves the same).
+SDK_CLEAR_PORT_DROPS_INPUT = False
 #: Baud rates scservo_sdk's PortHandler accepts.
 SDK_BAUDRATES = (4800, 9600, 14400, 19200, 38400, 57600, 115200, 128000, 250000, 500000, 1000000)
+#: Protocol -> how servos answer a broadcast ping: all at once (Feetech's protocol manual: "cannot be used
+#: when multiple servos are connected"), so one clean status packet means one servo and a damaged one several.
+BROADCAST_PING = {1.0: "at once"}
+#: STS/SMS store words low byte first, SCS high byte first (the Byte Order register says which): a word read
+#: without knowing the model needs that register first.
+ONE_BYTE_ORDER = False
 #: Model numbers stored at "Model Number" (LeRobot's MODEL_NUMBER_TABLE).
 MODEL_NUMBERS = {"STS3215": 777, "SCS0009": 1284}
 
@@ -59,7 +67,15 @@ BAUD_RATES = {"STS3215": _BAUD_RATES, "SCS0009": _BAUD_RATES}
 ERRBIT_INPUT_VOLTAGE, ERRBIT_OVERHEATING, ERRBIT_OVERLOAD = 0x01, 0x04, 0x20
 ERROR_BITS = {0x01: "input voltage", 0x02: "angle sensor", 0x04: "overheating", 0x08: "over current",
               0x20: "overload"}
+#: Model -> the bits of its Servo Status register (the same bits as a status packet's error byte).
+HARDWARE_ERROR_BITS = {"STS3215": ERROR_BITS, "SCS0009": ERROR_BITS}
+#: Status Return Level ("Response status level"): 0 answers reads (and pings) only, 1 every instruction.
+STATUS_RETURN_ALL_FROM, STATUS_RETURN_READS_FROM = 1, 0
+#: Feetech documents no reboot clearing its Servo Status.
+REBOOT_CLEARS_HARDWARE_ERROR = False
 INSTRUCTION_ERROR = {1.0: 0x40}
+#: No alert bit: every error is in the status packet's own bits (gaitbot.servos.dynamixel.ALERT_BITS).
+ALERT_BITS: dict[float, int] = {}
 
 
 def has_sync_read(protocol: float, byte_order: str) -> bool:

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite
-from gaitbot.bus.log import RecordingFailed
+from gaitbot.bus.recording import RecordingFailed
 from gaitbot.stream.clock import Clock, MonotonicClock
 from gaitbot.stream.health import HealthMonitor, ServoHealthStop
 from gaitbot.stream.pacing import StreamStats, Streamer, as_tick_frames
@@ -206,12 +206,10 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
                                    "the servos hold their last goal")
             else:
                 state.safe_stop(streamer, stop)
-                explain = getattr(bus, "explain_status_error", None)
-                if callable(explain):  # the robot is safe now: time to read what the fault was
-                    try:
-                        error = explain(exc)
-                    except (KeyboardInterrupt, Terminated):
-                        pass
+                try:  # the robot is safe now: time to read what the fault was
+                    error = bus.explain_status_error(exc)
+                except (KeyboardInterrupt, Terminated):
+                    pass
         except Exception:
             state.safe_stop(streamer, stop)
             state.finish(bus, ids, torque_off_on_exit)

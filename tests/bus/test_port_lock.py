@@ -12,7 +12,7 @@ from __future__ import annotations
 import pytest
 
 from gaitbot.bus.factory import bus_class
-from gaitbot.bus.mock import MockPort
+from gaitbot.bus.dry_run import DryRunPort
 from gaitbot.servos import wire
 from gaitbot.servos.models import servo_model
 
@@ -21,7 +21,7 @@ AX12 = servo_model("AX-12A")
 STS = servo_model("STS3215")
 
 
-class InterruptingPort(MockPort):
+class InterruptingPort(DryRunPort):
     """Raises KeyboardInterrupt once, from ``writePort`` (before the bytes leave) or from ``readPort``
     (while the reply is being read), during the next transaction whose instruction is ``instruction``."""
 
@@ -56,7 +56,7 @@ def _bus(backend: str, protocol: float, model, ids=(1, 2)):
     return bus, port
 
 
-def _goal_writes(port: MockPort) -> int:
+def _goal_writes(port: DryRunPort) -> int:
     return sum(wire.parse(p, port.framing, status=False).instruction == wire.INST_SYNC_WRITE
                for p in port.tx_packets)
 
