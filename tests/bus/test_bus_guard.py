@@ -46,3 +46,17 @@ def test_session_with_a_servo_outside_its_limits_moves_nothing():
     assert result.exit_code == 1 and isinstance(result.error, GoalOutsideLimits)
     goal_writes = [p for p in bus.port.tx_packets if p[7] == 0x83]  # sync write instruction (protocol 2.0)
     assert goal_writes == []
+
+
+def test_a_bus_layer_passes_on_every_ability_of_the_bus():
+    """BusLayer (the LimitGuard's base) overrides every public method and attribute the Bus declares, so a
+    layer never silently falls back to a Bus default instead of asking the bus under it."""
+    import inspect
+
+    from gaitbot.bus.base import Bus, BusLayer
+
+    declared = {name for name, value in vars(Bus).items() if not name.startswith("_")}
+    missing = sorted(name for name in declared if name not in vars(BusLayer))
+    assert not missing, f"BusLayer does not pass on {missing}"
+    assert {"write_goal_ticks", "read_back", "explain_status_error", "open_notes"} <= declared
+    assert not any(inspect.isfunction(v) and k == "__getattr__" for k, v in vars(BusLayer).items())
