@@ -2,7 +2,7 @@
 
 Tests mirror the packages (tests/servos, gait, robot, bus, stream, check, sim, app); helpers.py holds
 what several of them use. No test imports another test file, and the emulator is imported as the
-module it is (gaitbot.bus.emulator), never loaded by file path.
+module it is (gaitbot.emulator), never loaded by file path.
 """
 
 import pytest

@@ -9,7 +9,7 @@ Rules (also in docs/command-line.md, for whoever writes a page):
 - A command exits 0 unless its comment says ``exit N``. A comment that says ``Ctrl-C`` means the command
   runs until interrupted: it gets SIGINT after INTERRUPT_AFTER_S. Nothing it prints may be a traceback.
 - A command that needs hardware (``gaitbot walk``, ``record`` or ``scan`` without ``--dry-run`` or ``--sim``)
-  runs against the servo emulator (gaitbot.bus.emulator) of its robot on a pty, given as ``--port``: the
+  runs against the servo emulator (gaitbot.emulator) of its robot on a pty, given as ``--port``: the
   emulator answers as the servos do, through the same vendor SDKs. Such a command also gets
   ``--reply-timeout-ms 250`` unless it names one: the emulator shares a busy CI host with the suite, and a
   reply held up by the host is not what the text is about (faults are tests/app/test_emulator_e2e.py's).

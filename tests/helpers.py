@@ -40,14 +40,15 @@ def gaitbot(*args: str, timeout: float = WALK_TIMEOUT_S) -> subprocess.Completed
                           timeout=timeout, stdin=subprocess.DEVNULL, cwd=REPO_ROOT)
 
 
-def emulator_for(config_path: Path, log_path: Path, faults=None):
-    """The servo emulator (gaitbot.bus.emulator) of a robot config on a pty, logging the goals it receives."""
-    from gaitbot.bus import emulator as se
+def emulator_for(config_path: Path, log_path: Path, faults=None, model_numbers=None):
+    """The servo emulator (gaitbot.emulator) of a robot config on a pty, logging the goals it receives;
+    ``model_numbers`` (servo id -> number): servos that report another model number than their model's."""
+    import gaitbot.emulator as se
 
     robot = load_robot_config(config_path)
     return se.ServoEmulator(se.EmulatorConfig(
         robot.bus.backend, robot.bus.protocol, robot.models_by_id, robot.bus.baudrate, faults or se.Faults(),
-        str(log_path), robot.name, {j.name: j.id for j in robot.joints}))
+        str(log_path), robot.name, {j.name: j.id for j in robot.joints}, model_numbers=dict(model_numbers or {})))
 
 
 # --- recordings

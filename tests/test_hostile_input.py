@@ -26,7 +26,7 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 from gaitbot.app.cli import main
-from gaitbot.bus.log import read_log
+from gaitbot.bus.recording import read_log
 from gaitbot.gait.eigen import EigenGaitModel
 from gaitbot.gait.terrain.course_file import load_course
 from gaitbot.gait.trajectory import Trajectory

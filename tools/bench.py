@@ -121,7 +121,7 @@ def bench_stream(seconds: float) -> None:
     trajectory = generate_walk(geometry, [0.8 * config.gait.max_step_m] * n_steps, settings)
     frames = trajectory_ticks(config, trajectory)[: int(seconds * settings.rate_hz)]
     bus = make_bus(config.bus.backend, config.bus.protocol, "mock", config.bus.baudrate, config.models_by_id,
-                   dry_run=True)
+                   interface="dry-run")
     with bus, progress("streaming in real time", total=len(frames), unit="frame") as bar:
         stats = Streamer(bus, config.ids, 1.0 / settings.rate_hz, MonotonicClock(), frame_counter(bar)).run(frames)
     print(f"streaming, {len(frames) / settings.rate_hz:.0f} s real-time dry run at {settings.rate_hz:g} Hz "

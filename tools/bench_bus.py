@@ -1,10 +1,10 @@
 """Highest frame rate the real bus backends sustain through a pty, beside the wire limits.
 
 For each protocol, 6 and 12 servos: the real DynamixelBus / FeetechBus (vendor SDK PortHandler on
-the emulator's pty, gaitbot.bus.emulator on a thread, factory Return Delay Time) sends frames
+the emulator's pty, gaitbot.emulator on a thread, factory Return Delay Time) sends frames
 back to back for ``--seconds``: goal sync writes only, then a sync write plus a read of every
 servo (sync read where the protocol has one). Beside it, the wire limit from the packet sizes
-(gaitbot.bus.budget.frame_budget: 10 bits a byte, plus one return delay per status packet) at
+(gaitbot.servos.budget.frame_budget: 10 bits a byte, plus one return delay per status packet) at
 1 Mbaud and at 57,600 baud, without the 30 % margin the config check keeps.
 
     python tools/bench_bus.py              # about 20 s
@@ -24,13 +24,13 @@ import sys
 import time
 
 try:
-    from gaitbot.bus.budget import frame_budget
+    from gaitbot.servos.budget import frame_budget
 except ImportError:  # run from a checkout without installing
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
-    from gaitbot.bus.budget import frame_budget
+    from gaitbot.servos.budget import frame_budget
 
 from gaitbot.app.emulator import PROTOCOLS
-from gaitbot.bus import emulator as se
+import gaitbot.emulator as se
 from gaitbot.bus.factory import make_bus
 from gaitbot.servos.models import servo_model
 
@@ -43,7 +43,7 @@ def measure(protocol: str, n_servos: int, read_back: bool, seconds: float) -> fl
     with se.ServoEmulator(se.EmulatorConfig(backend, version, models)) as emulator:
         # throughput, not latency, is measured: the emulator's thread shares the GIL with the bus, so a busy
         # host can hold a reply past the SDK's 34 ms timeout; a generous timeout keeps that from ending the run
-        bus = make_bus(backend, version, emulator.path, 1_000_000, models, dry_run=False, reply_timeout_ms=500)
+        bus = make_bus(backend, version, emulator.path, 1_000_000, models, interface="serial", reply_timeout_ms=500)
         with bus:
             ids = list(models)
             frames, start = 0, time.perf_counter()

@@ -28,7 +28,7 @@ sys.path.insert(0, str(ROOT))
 from gaitbot.app.options import load_robot  # noqa: E402
 from gaitbot.app.progress import progress  # noqa: E402
 from gaitbot.app.record import TrajectorySink  # noqa: E402
-from gaitbot.bus import emulator as se  # noqa: E402
+import gaitbot.emulator as se  # noqa: E402
 from gaitbot.bus.factory import make_bus  # noqa: E402
 from gaitbot.gait import generate_walk  # noqa: E402
 from gaitbot.gait.eigen import cycles_from_trajectory, walk_label  # noqa: E402
@@ -52,7 +52,7 @@ def record_walk(config, step: float, out: Path) -> Trajectory:
                               se.Faults(), hand=hand)
     with se.ServoEmulator(chain) as emulator:
         bus = make_bus(config.bus.backend, config.bus.protocol, emulator.path, config.bus.baudrate,
-                       config.models_by_id, dry_run=False, reply_timeout_ms=REPLY_TIMEOUT_MS)
+                       config.models_by_id, interface="serial", reply_timeout_ms=REPLY_TIMEOUT_MS)
         result = record_session(bus, config.ids, 1.0 / config.gait.rate_hz, TrajectorySink(config, out, lambda t: None),
                                 confirm=lambda n: True, n_samples=len(ticks), clock=VirtualClock())
     if result.outcome != "completed":

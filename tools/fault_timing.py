@@ -23,8 +23,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from gaitbot.bus import emulator as se  # noqa: E402
-from gaitbot.bus.log import decode_goal_frames  # noqa: E402
+import gaitbot.emulator as se  # noqa: E402
+from gaitbot.bus.recording import decode_goal_frames  # noqa: E402
 from gaitbot.robot.config import load_robot_config  # noqa: E402
 
 FAULT_FRAME = 120

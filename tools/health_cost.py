@@ -6,7 +6,7 @@
 
 A session sends one goal sync write per frame and reads ONE servo back, in turn (gaitbot.stream.session).
 Reading that servo's health block (position, voltage, temperature, load) instead of its position alone adds
-the bytes printed here; the frame budget gaitbot checks every config against (gaitbot.bus.budget: the write
+the bytes printed here; the frame budget gaitbot checks every config against (gaitbot.servos.budget: the write
 plus a read-back of EVERY servo, 30 % margin) already counts more than that, so health reads fit the same
 budget. Bytes at 10 bits each, plus one return delay (the assumed 500 us) per status packet.
 """
@@ -18,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a source checkout too
 
-from gaitbot.bus.budget import BITS_PER_BYTE, DEFAULT_RETURN_DELAY_S, frame_budget, one_servo_read_back_bytes  # noqa: E402
+from gaitbot.servos.budget import BITS_PER_BYTE, DEFAULT_RETURN_DELAY_S, frame_budget, one_servo_read_back_bytes  # noqa: E402
 from gaitbot.robot.config import load_robot_config, resolve_config, shipped_config_names  # noqa: E402
 from gaitbot.servos.health import health_block  # noqa: E402
 

@@ -5,7 +5,7 @@
     python tools/servo_emulator.py --protocol dxl2 --ids 1-6 --late 3:60
     python tools/servo_emulator.py --robot config/xl430-biped.toml --factory-fresh --one-at-a-time
 
-A thin script around gaitbot.app.emulator (the command line) and gaitbot.bus.emulator (the engine,
+A thin script around gaitbot.app.emulator (the command line) and gaitbot.emulator (the engine,
 importable from tests); docs/emulator.md describes the options.
 """
 

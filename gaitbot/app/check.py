@@ -4,7 +4,7 @@
 command line offers it, ``args.allow_partial`` (check a recording whose last line was cut short by a
 crash, with a warning, instead of refusing it). Unreadable input raises a ``UserError`` (one line,
 exit 2); ``tools/check_trajectory.py`` calls the same. Files are read by their formats' own readers:
-a bus recording (gaitbot.bus.log.is_bus_log) or a trajectory (``.csv``/``.npz``, gaitbot.gait.trajectory;
+a bus recording (gaitbot.bus.recording.is_bus_log) or a trajectory (``.csv``/``.npz``, gaitbot.gait.trajectory;
 a ``.csv`` whose last line has no newline is taken as truncated). docs/checking.md says what is checked.
 """
 
@@ -16,7 +16,7 @@ from pathlib import Path
 
 from gaitbot.app.arguments import add_command, robot_options
 from gaitbot.app.options import UsageError, load_robot
-from gaitbot.bus.log import is_bus_log
+from gaitbot.bus.recording import is_bus_log
 from gaitbot.check.preflight import preflight
 from gaitbot.check.recording import check_recording, robot_for_recording
 from gaitbot.gait.trajectory import load_fast, refuse_truncated_csv

@@ -1,4 +1,4 @@
-"""The servo emulator's command line (``python tools/servo_emulator.py``; the engine is gaitbot.bus.emulator).
+"""The servo emulator's command line (``python tools/servo_emulator.py``; the engine is gaitbot.emulator).
 
 Opens a pty pair, prints the device path (the end a driver opens) as the first line of its output,
 and answers on it like a chain of servos until Ctrl-C:
@@ -22,8 +22,9 @@ import math
 import sys
 
 from gaitbot.app.cli import OneLineParser
-from gaitbot.bus.emulator import (FAULT_KINDS, EmulatorConfig, Faults, Heat, ServoEmulator, hand_from_ticks,
-                                  hand_from_trajectory)
+from gaitbot.emulator import FAULT_KINDS, EmulatorConfig, Faults, Hand, Heat, ServoEmulator, hand_from_ticks
+from gaitbot.gait.trajectory import Trajectory
+from gaitbot.robot.calibration import trajectory_ticks
 from gaitbot.robot.calibration_file import load_robot_with_calibration
 from gaitbot.servos import baud_rates, baud_register_value
 from gaitbot.servos.models import servo_model
@@ -94,6 +95,19 @@ def _id_numbers(items, flag: str, low: float, high: float, unit: str) -> dict[in
     return out
 
 
+def hand_from_trajectory(robot, path: str, rate_hz: float | None = None) -> Hand:
+    """A hand playing a trajectory file (.csv/.npz): its angles through the robot's calibration, held
+    joints at their hold angle (the emulator room knows no gait: it is given the ticks). Ticks outside a
+    servo's encoder range cannot be reported: refused."""
+    ticks = trajectory_ticks(robot, Trajectory.load(path))
+    for column, joint in enumerate(robot.joints):
+        low, high = int(ticks[:, column].min()), int(ticks[:, column].max())
+        if low < joint.model.min_tick or high > joint.model.max_tick:
+            raise ValueError(f"--hand {path}: {joint.name} goes to ticks {low}..{high}, outside the "
+                             f"{joint.model.name}'s {joint.model.min_tick}..{joint.model.max_tick}")
+    return Hand({joint.id: ticks[:, column].tolist() for column, joint in enumerate(robot.joints)}, rate_hz)
+
+
 def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
     check_numbers(args)
     config = _chain_from_args(args)
@@ -107,6 +121,11 @@ def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
     if not args.voltage_sag >= 0:
         raise ValueError(f"--voltage-sag must be 0 or more volts per second, got {args.voltage_sag}")
     config.supply_v, config.voltage_sag_v_per_s = args.supply_v, args.voltage_sag
+    numbers = _id_numbers(args.model_number, "--model-number", 0, 65535, "(a model number)")
+    absent = sorted(set(numbers) - set(config.models))
+    if absent:
+        raise ValueError(f"--model-number: servo {', '.join(map(str, absent))} is not on the chain")
+    config.model_numbers = {servo_id: int(number) for servo_id, number in numbers.items()}
     if args.one_at_a_time and not config.fresh:
         raise ValueError("--one-at-a-time needs --factory-fresh (a chain of new servos, connected one by one)")
     config.one_at_a_time = args.one_at_a_time
@@ -228,6 +247,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "e.g. 12.0 V for X and AX, 7.4 V for STS3215)")
     p.add_argument("--voltage-sag", type=float, default=0.0, metavar="V_PER_S",
                    help="the supply falls this many volts per second once faults start (--fault-after-*)")
+    p.add_argument("--model-number", action="append", metavar="ID:NUMBER", help="this servo reports this model "
+                   "number (ping and its Model Number register), e.g. 3:1060 for an XL430-W250 among XM430s")
     return p
 
 

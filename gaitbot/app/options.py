@@ -1,6 +1,6 @@
 """Reading the command line's options: the one place each option is validated and turned into rooms' inputs.
 
-Robot loading (with the bus budget hook), ``--rate`` / ``--reply-timeout-ms`` / length checks written
+Robot loading, ``--rate`` / ``--reply-timeout-ms`` / length checks written
 once, the leg and walk settings (``gait_source``) and the step list. Errors for people are raised as
 ``UsageError`` (one line, exit status 2, nothing sent to a servo).
 """
@@ -11,13 +11,12 @@ import math
 import os
 from pathlib import Path
 
-from gaitbot.bus.budget import bus_budget_check, check_robot_rate
 from gaitbot.errors import UserError
 from gaitbot.gait.geometry import LegGeometry
 from gaitbot.gait.planning import perturb_steps, steps_for_distance
 from gaitbot.gait.walker import WalkSettings, longest_step_m
 from gaitbot.robot.calibration_file import load_robot_with_calibration
-from gaitbot.robot.config import RATE_RANGE_HZ, ConfigError, RobotConfig
+from gaitbot.robot.config import RATE_RANGE_HZ, ConfigError, RobotConfig, check_bus_rate
 from gaitbot.robot.walk_settings import GaitSource, leg_geometry, walk_settings
 
 
@@ -29,14 +28,14 @@ def load_robot(robot: str | None, calibration: str | None = None) -> RobotConfig
     """The robot config named by ``--robot`` (a path or a shipped name), or the built-in default, with its
     calibration applied (``--calibration FILE``, else ``<config>.calibration.toml`` beside it if there is
     one: gaitbot.robot.calibration_file); a ``gait.rate_hz`` the bus cannot carry is refused at load
-    (gaitbot.bus.budget)."""
+    (gaitbot.robot.config.check_bus_rate)."""
     if robot is not None and not robot.strip():
         raise UsageError("--robot: empty name; give a .toml path or a shipped robot name (leave --robot out for "
                          "the default robot)")
     if calibration is not None and not calibration.strip():
         raise UsageError("--calibration: empty file name")
     try:
-        return load_robot_with_calibration(robot, calibration, extra_checks=[bus_budget_check])
+        return load_robot_with_calibration(robot, calibration)
     except (ConfigError, UserError):
         raise
     except (OSError, ValueError, KeyError) as exc:
@@ -90,7 +89,7 @@ def check_rate_option(config: RobotConfig, rate_hz: float | None, label: str | N
         return
     check_rate_range(rate_hz, label or "--rate")
     try:
-        check_robot_rate(config, rate_hz)
+        check_bus_rate(config, rate_hz)
     except ValueError as exc:
         raise UsageError(f"{label or f'--rate {rate_hz:g}'}: {exc}") from None
 

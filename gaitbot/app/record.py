@@ -197,7 +197,7 @@ def run(args) -> int:
                             hold_at_end=args.hold, setup_writes=gain_writes(config), health=health)
     if sink.status is not None and sink.writer is not None:
         sys.stderr.write("\n")
-    for note in getattr(bus, "open_notes", []):
+    for note in bus.open_notes:
         print(f"note: {note}", file=sys.stderr)
     for line in sink.limits.summary():
         warn(line)

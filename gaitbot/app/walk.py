@@ -17,7 +17,7 @@ from gaitbot.app.planned_walk import PlannedWalk, planned_walk
 from gaitbot.app.progress import callback, progress
 from gaitbot.app.view_options import add_view_options, open_view
 from gaitbot.bus.factory import guarded, make_robot_bus
-from gaitbot.bus.log import BusRecorder, RecordingFailed
+from gaitbot.bus.recording import BusRecorder, RecordingFailed
 from gaitbot.check.preflight import preflight
 from gaitbot.errors import UserError
 from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
@@ -139,7 +139,7 @@ def run(args) -> int:
             recorder.close()
         if view is not None:
             view.close()
-    for note in getattr(bus, "open_notes", []):
+    for note in bus.open_notes:
         print(f"note: {note}", file=sys.stderr)
     return _report(args, config, walk, result, sim, port, clock, health)
 
@@ -160,7 +160,7 @@ def _open_bus(args, config, port: str, sim, clock, recorder: BusRecorder | None)
         if sim is not None:
             return guarded(config, sim.make_bus(clock.now, recorder))
         return make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,
-                              reply_timeout_ms=args.reply_timeout_ms)
+                              reply_timeout_ms=args.reply_timeout_ms, clock=clock.now)
     except (OSError, RecordingFailed) as exc:
         if recorder is None:
             raise

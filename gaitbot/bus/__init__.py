@@ -1,19 +1,22 @@
-"""The bus room: packets. One abstract servo bus, the vendor SDKs' backends, and what sits around them.
+"""The bus room: packets. One abstract servo bus, one transport per vendor on its SDK, and what sits around them.
 
-    make_bus(backend, protocol, port, baudrate, models, dry_run, recorder=None) -> Bus
-    make_robot_bus(config, port=None, dry_run=False, recorder=None) -> LimitGuard
+    make_bus(backend, protocol, port, baudrate, models, interface="serial"|"dry-run", recorder=None) -> Bus
+    make_robot_bus(config, port=None, dry_run=False, recorder=None, clock=...) -> LimitGuard
 
-``base`` (the Bus and its errors), ``sdk_bus`` + ``dynamixel`` + ``feetech`` (the SDK backends),
-``factory``, ``guard`` (the LimitGuard: no goal outside a joint's limits), ``budget`` (what a frame
-costs on the wire), ``mock`` (MockPort, under the real SDK code in dry runs), ``log`` (the bus-log
-format: its writer and its one reader), ``serial_latency`` (the USB adapter's latency timer) and
-``emulator`` (a servo chain in time on a pty). The simulated robot (gaitbot.sim) is a port of its
-own under the same backends.
+``base`` (the Bus, its errors, BusLayer), ``sdk_bus`` (the transport both SDKs share) with its parts
+``read_back`` (the per-frame budgeted read), ``late_replies`` and ``bus_faults``, ``dynamixel`` and
+``feetech`` (one transport per vendor: only the SDK and its quirks), ``port`` (the serial port under the
+SDK: errors, stale input, reply timeout), ``packets`` (the one packet splitter and parser), ``factory``
+(a bus by vendor and interface name), ``guard`` (the LimitGuard: no goal outside a joint's limits),
+``dry_run`` (the dry-run port, under the real SDK code), ``recording`` (the recording format: writer and
+reader), ``probe`` and ``bringup`` (servos not known yet: scan, setup) and ``serial_latency`` (the USB
+adapter's latency timer). The servo emulator is a room of its own (gaitbot.emulator); the simulated robot
+(gaitbot.sim) is a port of its own under the same transports.
 """
 
 from gaitbot.bus.base import (Bus, BusError, CorruptReplies, PortError, ServoLate, ServoStatusError,
-                              ServoTimeout)
-from gaitbot.bus.factory import make_bus, make_mock_bus, make_robot_bus
+                              ServoTimeout, WrongServoModel)
+from gaitbot.bus.factory import make_bus, make_dry_run_bus, make_robot_bus
 
 __all__ = ["Bus", "BusError", "CorruptReplies", "PortError", "ServoLate", "ServoStatusError", "ServoTimeout",
-           "make_bus", "make_mock_bus", "make_robot_bus"]
+           "WrongServoModel", "make_bus", "make_dry_run_bus", "make_robot_bus"]

@@ -8,7 +8,10 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+from enum import StrEnum
+from types import MappingProxyType
 
+from gaitbot.servos import model_name_of
 from gaitbot.servos.health import HealthReading
 from gaitbot.servos.registers import RegisterWrite
 
@@ -57,20 +60,47 @@ class ServoStatusError(BusError):
         self.fault = fault
 
 
+class WrongServoModel(BusError):
+    """Servos that answered with another model number than their configured model's: ``wrong`` lists
+    (servo id, model number found). Raised before anything is written, so a servo of another model is
+    never driven with the configured model's gains, limits and thresholds."""
+
+    def __init__(self, wrong, models, backend: str, port_name: str) -> None:
+        self.wrong = [(int(i), int(n)) for i, n in wrong]
+        parts = []
+        for servo_id, number in self.wrong:
+            expected = models[servo_id]
+            found = model_name_of(backend, number) or "a model gaitbot does not know"
+            parts.append(f"servo {servo_id} is a {found} (model number {number}), the config expects a "
+                         f"{expected.name} (model number {expected.model_number})")
+        super().__init__(f"wrong servo model on {port_name}: {'; '.join(parts)}; nothing was written "
+                         "(fit the configured servo, or describe the robot's real servos in its config)",
+                         servo_id=self.wrong[0][0])
+
+
+class ReadBackOutcome(StrEnum):
+    """How a per-frame read-back ended: ANSWERED (a status packet that answers this very request, in
+    budget), MISSED (none in budget: the read is abandoned for this frame), DAMAGED (only a damaged status
+    packet in budget), SKIPPED (no budget left in the frame: nothing was sent, nothing is counted)."""
+
+    ANSWERED = "answered"
+    MISSED = "missed"
+    DAMAGED = "damaged"
+    SKIPPED = "skipped"
+
+
 @dataclass(frozen=True)
 class ReadBack:
     """One budgeted, non-blocking read of one servo (:meth:`Bus.read_back`), as the session sees it.
 
-    outcome: "answered" (a status packet that answers this very request, in budget), "missed" (none
-    in budget: the read is abandoned for this frame), "damaged" (only a damaged status packet in
-    budget), "skipped" (no budget left in the frame: nothing was sent, nothing is counted).
+    outcome: a :class:`ReadBackOutcome`.
     ticks: present position when answered. data: the register block read (``set_read_back_blocks``),
     when answered. error: the status packet's error byte. late_s: how late this servo's latest
     reply to an abandoned read came, if one came since the last read-back (None: none seen).
     """
 
     servo_id: int
-    outcome: str
+    outcome: ReadBackOutcome
     ticks: int | None = None
     data: bytes = b""
     error: int = 0
@@ -78,14 +108,21 @@ class ReadBack:
 
     @property
     def answered(self) -> bool:
-        return self.outcome == "answered"
+        return self.outcome == ReadBackOutcome.ANSWERED
 
 
 class Bus(ABC):
-    """A chain of servos on one serial bus.
+    """A chain of servos on one serial bus: every ability the stream and the bring-up commands use.
 
-    Positions are raw ticks; calibration (angles <-> ticks) lives in the robot room.
+    Positions are raw ticks; calibration (angles <-> ticks) lives in the robot room. Optional abilities
+    have a default here, so callers never probe for them. ``port_name`` names the port in messages;
+    ``open_notes`` say how the port was opened when that differs from the config; ``model_numbers`` holds
+    the model number each servo's last ping reported (empty where pings read none).
     """
+
+    port_name: str = "the bus"
+    open_notes: tuple[str, ...] | list[str] = ()
+    model_numbers: Mapping[int, int] = MappingProxyType({})
 
     @abstractmethod
     def open(self) -> None: ...
@@ -106,13 +143,8 @@ class Bus(ABC):
 
     @abstractmethod
     def write_goal_ticks(self, goals: Mapping[int, int]) -> None:
-        """Write every goal position of one frame in one sync-write packet."""
-
-    def send_goal_ticks(self, goals: Mapping[int, int]) -> None:
-        """Write goals already checked by the caller (the LimitGuard, whose limits lie inside the servos'
-        tick ranges), so that each goal is checked once on the 60 Hz path. Backends that check goals
-        themselves in write_goal_ticks override this to skip that check."""
-        self.write_goal_ticks(goals)
+        """Write every goal position of one frame in one sync-write packet: the one goal-writing method
+        (a LimitGuard in front checks each goal against its joint's limits first)."""
 
     @abstractmethod
     def read_present_ticks(self, ids: Iterable[int]) -> dict[int, int]:
@@ -133,12 +165,17 @@ class Bus(ABC):
         read of a walk session: docs/bus-faults.md). Backends that talk to servos override this; the
         default asks ``read_present_ticks`` (which may block: for in-memory buses only)."""
         if budget_s <= 0:
-            return ReadBack(servo_id, "skipped")
+            return ReadBack(servo_id, ReadBackOutcome.SKIPPED)
         try:
             ticks = self.read_present_ticks([servo_id]).get(servo_id)
         except ServoTimeout:
-            return ReadBack(servo_id, "missed")
-        return ReadBack(servo_id, "answered" if ticks is not None else "missed", ticks)
+            return ReadBack(servo_id, ReadBackOutcome.MISSED)
+        return ReadBack(servo_id, ReadBackOutcome.ANSWERED if ticks is not None else ReadBackOutcome.MISSED, ticks)
+
+    def explain_status_error(self, exc: BusError) -> BusError:
+        """``exc`` with what the session could not read during the walk (a hardware error register), read
+        now that the robot is safe; buses with nothing more to read return it as it is."""
+        return exc
 
     def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
         """Write a setting (a gain, a lock flag) to each servo, waiting for each one's status packet.
@@ -155,5 +192,62 @@ class Bus(ABC):
         self.close()
 
 
-__all__ = ["Bus", "HealthReading", "BusError", "ReadBack", "PortError", "ServoTimeout", "ServoLate", "CorruptReplies",
-           "ServoStatusError", "RegisterWrite"]
+class BusLayer(Bus):
+    """A bus in front of another (``inner``) with the same interface: every ability passes through
+    unchanged, and a layer overrides only what it adds (the LimitGuard: its goal check). Written once
+    here, beside the Bus it mirrors; tests/bus/test_bus_guard.py checks it passes on every Bus method."""
+
+    def __init__(self, inner: Bus) -> None:
+        self.inner = inner
+
+    @property
+    def port_name(self) -> str:  # type: ignore[override]
+        return self.inner.port_name
+
+    @property
+    def open_notes(self):  # type: ignore[override]
+        return self.inner.open_notes
+
+    @property
+    def model_numbers(self) -> Mapping[int, int]:  # type: ignore[override]
+        return self.inner.model_numbers
+
+    def open(self) -> None:
+        self.inner.open()
+
+    def close(self) -> None:
+        self.inner.close()
+
+    def ping(self, servo_id: int) -> bool:
+        return self.inner.ping(servo_id)
+
+    def scan(self, ids: Iterable[int]) -> list[int]:
+        return self.inner.scan(ids)
+
+    def set_torque(self, ids: Iterable[int], enabled: bool) -> None:
+        self.inner.set_torque(ids, enabled)
+
+    def write_goal_ticks(self, goals: Mapping[int, int]) -> None:
+        self.inner.write_goal_ticks(goals)
+
+    def read_present_ticks(self, ids: Iterable[int]) -> dict[int, int]:
+        return self.inner.read_present_ticks(ids)
+
+    def read_health(self, servo_id: int) -> HealthReading:
+        return self.inner.read_health(servo_id)
+
+    def set_read_back_blocks(self, blocks: dict[int, tuple[int, int]]) -> None:
+        self.inner.set_read_back_blocks(blocks)
+
+    def read_back(self, servo_id: int, budget_s: float) -> ReadBack:
+        return self.inner.read_back(servo_id, budget_s)
+
+    def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
+        self.inner.write_register(ids, address, length, value)
+
+    def explain_status_error(self, exc: BusError) -> BusError:
+        return self.inner.explain_status_error(exc)
+
+
+__all__ = ["Bus", "BusLayer", "HealthReading", "BusError", "ReadBack", "ReadBackOutcome", "PortError", "ServoTimeout", "ServoLate", "CorruptReplies",
+           "ServoStatusError", "RegisterWrite", "WrongServoModel"]

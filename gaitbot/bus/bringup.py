@@ -3,7 +3,8 @@ what a servo says about itself (gaitbot setup, gaitbot scan). The people's side 
 gaitbot/app/setup.py and scan.py; docs/bring-up.md tells the whole story.
 
 Giving a servo its id and baud rate (:func:`assign_id_and_baud`) writes exactly these registers, in this
-order, and nothing else (vendor-facts.md section 7; LeRobot's ``setup_motor`` does the same):
+order, and nothing else (the e-Manual's "ID" and "Baud Rate" control-table entries; LeRobot's
+``setup_motor`` does the same):
 
 1. Torque Enable = 0 (EEPROM is writable only with torque off on Dynamixel; Feetech is not documented
    either way, so it is done there too), confirmed;
@@ -24,10 +25,10 @@ from dataclasses import dataclass, field
 
 from gaitbot.bus.base import BusError, ServoTimeout
 from gaitbot.bus.probe import ProbeBus, ProbeResult, ServoFound
-from gaitbot.servos import baud_rates, baud_register_value, dynamixel, feetech
+from gaitbot.servos import baud_rates, baud_register_value
 from gaitbot.servos.health import HealthReading, decode_health, health_block
 from gaitbot.servos.models import ServoModel
-from gaitbot.servos.status import describe_status_error
+from gaitbot.servos.status import describe_status_error, hardware_error_bits
 
 
 class SetupFailed(BusError):
@@ -68,7 +69,7 @@ def assign_id_and_baud(probe: ProbeBus, found: ServoFound, model: ServoModel, ne
         raise ValueError(f"a {model.name} cannot run at {new_baudrate:,} baud (its Baud Rate register holds {rates})")
     table = model.control_table
     torque, servo_id_reg, baud = table["Torque Enable"], table["ID"], table["Baud Rate"]
-    lock = table.get("Lock") if model.family == "feetech" else None
+    lock = table.get("Lock")  # Feetech's EEPROM lock (Dynamixel tables have none)
     writes: list[tuple[str, int]] = []
     probe.set_baudrate(found.baudrate)
     servo_id = found.servo_id
@@ -159,7 +160,7 @@ def describe_servo(probe: ProbeBus, found: ServoFound) -> ServoReport:
     if register is not None:
         got = read("Hardware Error Status" if "Hardware Error Status" in table else "Servo Status")
         if got and got[0][0]:
-            names = feetech.ERROR_BITS if model.family == "feetech" else dynamixel.HARDWARE_ERROR_BITS[model.name]
+            names = hardware_error_bits(model.name)
             errors = [name for bit, name in names.items() if got[0][0] & bit] or [f"0x{got[0][0]:02X}"]
     elif status_error:  # AX: the errors come in every status packet
         errors = describe_status_error(model.family, probe.protocol, status_error, model_name=model.name).split(", ")

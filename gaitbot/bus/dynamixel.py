@@ -35,12 +35,13 @@ class DynamixelBus(SdkBus):
     family = "dynamixel"
     sdk = dynamixel_sdk
 
-    def __init__(self, port_name, baudrate, protocol, models, port_handler=None, retries=3):
+    def __init__(self, port_name, baudrate, protocol, models, **kwargs):
         if float(protocol) not in (1.0, 2.0):
             raise ValueError(f"Dynamixel protocol must be 1.0 or 2.0, got {protocol!r}")
-        super().__init__(port_name, baudrate, protocol, models, port_handler=port_handler, retries=retries)
+        super().__init__(port_name, baudrate, protocol, models, **kwargs)
 
-    def _make_packet_handler(self):
-        if self.protocol == 2.0:
+    @classmethod
+    def make_packet_handler(cls, protocol: float, byte_order: str = "little"):
+        if float(protocol) == 2.0:
             return StuffingProtocol2PacketHandler()
         return dynamixel_sdk.PacketHandler(1.0)  # the SDK compares with the float 1.0

@@ -1,16 +1,28 @@
-"""Build a bus from configuration: the one place that knows which class and port to use."""
+"""Build a bus from configuration: the one place that knows which class and which port to use.
+
+The vendor (``backend``: gaitbot.servos.BACKENDS) chooses the bus class (:data:`BUS_CLASSES`); the
+interface chooses the port under the vendor's SDK (:data:`INTERFACES`), by name as python-can chooses
+its ``interface``: ``"serial"`` (the SDK's own PortHandler on a serial device) or ``"dry-run"`` (the
+dry-run port, gaitbot.bus.dry_run: a healthy chain behind the real SDK code). The simulated robot
+(gaitbot.sim) hands in a port of its own. A new vendor is a bus class here (its module beside
+dynamixel.py and feetech.py) and a vendor module in gaitbot.servos; a new interface is an entry in
+INTERFACES.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import time
+from collections.abc import Callable, Mapping
+from typing import Any
 
 from gaitbot.bus.base import Bus
+from gaitbot.bus.dry_run import DryRunPort
 from gaitbot.bus.dynamixel import DynamixelBus
 from gaitbot.bus.feetech import FeetechBus
 from gaitbot.bus.guard import LimitGuard
-from gaitbot.bus.log import BusRecorder
-from gaitbot.bus.mock import MockPort
+from gaitbot.bus.port import set_reply_timeout
 from gaitbot.bus.probe import ProbeBus
+from gaitbot.bus.recording.writer import BusRecorder
 from gaitbot.robot.calibration import tick_limits
 from gaitbot.robot.config import RobotConfig
 from gaitbot.servos.models import ServoModel
@@ -18,24 +30,52 @@ from gaitbot.servos.models import ServoModel
 #: Backend name (gaitbot.servos.BACKENDS) -> its bus class.
 BUS_CLASSES: dict[str, type] = {cls.family: cls for cls in (DynamixelBus, FeetechBus)}
 
+SERIAL, DRY_RUN = "serial", "dry-run"
 
-def make_bus(backend: str, protocol: float, port: str, baudrate: int, models: Mapping[int, ServoModel],
-             dry_run: bool, recorder: BusRecorder | None = None, retries: int = 3,
-             reply_timeout_ms: float | None = None) -> Bus:
-    """The bus for ``backend``; with ``dry_run`` the same class talks to a MockPort instead of ``port``.
 
-    With ``recorder`` every byte in both directions is logged (dry run or real). The bus is not
-    opened here; use it as a context manager or call open(). ``reply_timeout_ms`` replaces the
-    SDK's reply timeout (2 x 16 ms USB latency + 2 ms + the packet's bytes) when set.
+def _serial_port(backend: str, protocol: float, port: str, baudrate: int | None,
+                 models: Mapping[int, ServoModel], reply_timeout_ms: float | None) -> Any:
+    handler = bus_class(backend).sdk.PortHandler(port)
+    set_reply_timeout(handler, reply_timeout_ms)
+    return handler
+
+
+def _dry_run_port(backend: str, protocol: float, port: str, baudrate: int | None,
+                  models: Mapping[int, ServoModel], reply_timeout_ms: float | None) -> Any:
+    return DryRunPort(backend, protocol, models, port_name=port, baudrate=baudrate)
+
+
+#: Interface name -> the port handler it makes: (backend, protocol, port name, baud rate, the servos
+#: behind it, reply timeout in ms or None) -> a PortHandler-like object.
+INTERFACES: dict[str, Callable[..., Any]] = {SERIAL: _serial_port, DRY_RUN: _dry_run_port}
+
+
+def port_handler(interface: str, backend: str, protocol: float, port: str, baudrate: int | None,
+                 models: Mapping[int, ServoModel], reply_timeout_ms: float | None = None) -> Any:
+    """The port of ``interface`` (ValueError naming the known ones)."""
+    try:
+        make = INTERFACES[interface]
+    except KeyError:
+        raise ValueError(f"unknown bus interface {interface!r} (known: {', '.join(INTERFACES)})") from None
+    return make(backend, protocol, port, baudrate, models, reply_timeout_ms)
+
+
+def make_bus(backend: str, protocol: float, port: str, baudrate: int, models: Mapping[int, ServoModel], *,
+             interface: str = SERIAL, recorder: BusRecorder | None = None, retries: int = 3,
+             reply_timeout_ms: float | None = None, clock: Callable[[], float] = time.monotonic) -> Bus:
+    """The bus for ``backend`` on the port of ``interface`` (``"serial"``: ``port`` is a device;
+    ``"dry-run"``: the dry-run port, ``port`` only names it).
+
+    With ``recorder`` every byte in both directions is logged. The bus is not opened here; use it as a
+    context manager or call open(). ``reply_timeout_ms`` replaces the SDK's reply timeout (2 x 16 ms USB
+    latency + 2 ms + the packet's bytes) when set. ``clock`` (seconds) measures the read-back's budgets:
+    pass the session's clock.
     """
     cls = bus_class(backend)
-    handler = MockPort(backend, protocol, models, port_name=port, baudrate=baudrate) if dry_run \
-        else cls.sdk.PortHandler(port)
-    if reply_timeout_ms is not None and not dry_run:
-        _set_reply_timeout(handler, reply_timeout_ms)
+    handler = port_handler(interface, backend, protocol, port, baudrate, models, reply_timeout_ms)
     if recorder is not None:
         handler = recorder.wrap(handler, backend=backend, protocol=protocol, baudrate=baudrate, models=models)
-    return cls(port, baudrate, protocol, models, port_handler=handler, retries=retries)
+    return cls(port, baudrate, protocol, models, port_handler=handler, retries=retries, clock=clock)
 
 
 def bus_class(backend: str) -> type:
@@ -52,39 +92,27 @@ def guarded(config: RobotConfig, bus: Bus) -> LimitGuard:
 
 
 def make_robot_bus(config: RobotConfig, port: str | None = None, *, dry_run: bool = False,
-                   recorder: BusRecorder | None = None, reply_timeout_ms: float | None = None) -> LimitGuard:
-    """The bus of a robot config (on ``port``, default the config's), wrapped in its LimitGuard.
-
-    Not opened: use it as a context manager, or hand it to a session."""
+                   recorder: BusRecorder | None = None, reply_timeout_ms: float | None = None,
+                   clock: Callable[[], float] = time.monotonic) -> LimitGuard:
+    """The bus of a robot config (on ``port``, default the config's; ``dry_run``: on the dry-run port),
+    wrapped in its LimitGuard. Not opened: use it as a context manager, or hand it to a session."""
     bus = make_bus(config.bus.backend, config.bus.protocol, port or config.bus.port, config.bus.baudrate,
-                   config.models_by_id, dry_run=dry_run, recorder=recorder, reply_timeout_ms=reply_timeout_ms)
+                   config.models_by_id, interface=DRY_RUN if dry_run else SERIAL, recorder=recorder,
+                   reply_timeout_ms=reply_timeout_ms, clock=clock)
     return guarded(config, bus)
 
 
-def _set_reply_timeout(handler, reply_timeout_ms: float) -> None:
-    """Make the SDK's PortHandler wait ``reply_timeout_ms`` for each status packet.
-
-    Both SDKs compute the timeout in setPacketTimeout from a module-wide 16 ms latency constant;
-    slow adapters (or a busy host driving a pseudo-terminal) need more. Patched on this instance
-    only, so other buses keep the SDK's figure."""
-    def set_packet_timeout(packet_length, _handler=handler):
-        _handler.packet_start_time = _handler.getCurrentTime()
-        _handler.packet_timeout = _handler.tx_time_per_byte * packet_length + reply_timeout_ms
-
-    handler.setPacketTimeout = set_packet_timeout
-
-
-def make_mock_bus(backend: str, protocol: float, models: Mapping[int, ServoModel], baudrate: int = 1_000_000,
-                  recorder: BusRecorder | None = None) -> Bus:
-    """A dry-run bus (the real backend class on a MockPort); its port is ``bus.port``."""
-    return make_bus(backend, protocol, "mock", baudrate, models, dry_run=True, recorder=recorder)
+def make_dry_run_bus(backend: str, protocol: float, models: Mapping[int, ServoModel], baudrate: int = 1_000_000,
+                     recorder: BusRecorder | None = None) -> Bus:
+    """A bus on the dry-run port (the real backend class on a DryRunPort); its port is ``bus.port``."""
+    return make_bus(backend, protocol, "mock", baudrate, models, interface=DRY_RUN, recorder=recorder)
 
 
 def make_probe_bus(backend: str, protocol: float, port: str, *, dry_run: bool = False,
                    models: Mapping[int, ServoModel] | None = None, baudrate: int | None = None,
                    reply_timeout_ms: float | None = None) -> ProbeBus:
-    """A bus of servos not known yet (gaitbot setup, scan) on ``port``; with ``dry_run`` a MockPort holding
-    ``models`` set to ``baudrate``. Not opened here."""
-    handler = MockPort(backend, protocol, models or {}, port_name=port, baudrate=baudrate) if dry_run \
-        else bus_class(backend).sdk.PortHandler(port)
-    return ProbeBus(backend, protocol, port, handler, reply_timeout_ms=reply_timeout_ms)
+    """A bus of servos not known yet (gaitbot setup, scan) on ``port``: the same vendor class's SDK and
+    packet handler, on the port of the same interfaces (``dry_run``: a dry-run port holding ``models`` set
+    to ``baudrate``). Not opened here."""
+    handler = port_handler(DRY_RUN if dry_run else SERIAL, backend, protocol, port, baudrate, models or {})
+    return ProbeBus(bus_class(backend), protocol, port, handler, reply_timeout_ms=reply_timeout_ms)

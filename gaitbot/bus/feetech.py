@@ -26,7 +26,7 @@ class FeetechBus(SdkBus):
     family = "feetech"
     sdk = scservo_sdk
 
-    def __init__(self, port_name, baudrate, protocol, models, port_handler=None, retries=3):
+    def __init__(self, port_name, baudrate, protocol, models, **kwargs):
         orders = {}
         for servo_id, model in models.items():
             orders.setdefault(model.byte_order, (servo_id, model.name))
@@ -36,12 +36,13 @@ class FeetechBus(SdkBus):
                 f"FeetechBus on {port_name}: servo {id_a} ({name_a}, low byte first) and servo {id_b} "
                 f"({name_b}, high byte first) cannot share one bus: scservo_sdk keeps the byte order in one "
                 "process-wide setting (scservo_def.SCS_END). Put STS/SMS and SCS servos on separate buses.")
-        super().__init__(port_name, baudrate, protocol, models, port_handler=port_handler, retries=retries)
+        super().__init__(port_name, baudrate, protocol, models, **kwargs)
         self.byte_order = next(iter(self.models.values())).byte_order
         self.scs_end = SCS_END_FOR_BYTE_ORDER[self.byte_order]
 
-    def _make_packet_handler(self):
-        return scservo_sdk.PacketHandler(self.scs_end)  # sets SCS_END as a side effect
+    @classmethod
+    def make_packet_handler(cls, protocol: float, byte_order: str = "little"):
+        return scservo_sdk.PacketHandler(SCS_END_FOR_BYTE_ORDER[byte_order])  # sets SCS_END as a side effect
 
     def _before_transaction(self) -> None:
         scservo_def.SCS_SETEND(self.scs_end)

@@ -5,8 +5,8 @@ write the few registers bring-up needs (gaitbot setup, gaitbot scan).
 the protocol. It uses the vendor SDK's PortHandler and packet handler (ping, read, write) like the walk
 does; two exchanges are its own, because the SDKs offer none that fits:
 
-* **broadcast ping** (Dynamixel 2.0 and Feetech): one PING to id 254 and every status packet that comes
-  back, read with gaitbot.servos.wire. Dynamixel 2.0 servos answer one after another in id order
+* **broadcast ping** (Dynamixel 2.0 and Feetech: ``BROADCAST_PING`` of the vendor facts): one PING to id
+  254 and every status packet that comes back, read with gaitbot.bus.packets. Dynamixel 2.0 servos answer one after another in id order
   (e-Manual Protocol 2.0, "Ping"); the probe waits the SDK's own window for that (253 status packets'
   bytes + 3 ms a servo + 16 ms, ``broadcastPing`` in dynamixel_sdk), or, given ``reply_timeout_ms``,
   until the line has been quiet that long. Feetech servos all answer a broadcast ping at once
@@ -30,8 +30,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from gaitbot.bus.base import PortError, ServoTimeout
-from gaitbot.bus.sdk_bus import PORT_EXCEPTIONS, is_pseudo_terminal
-from gaitbot.servos import control_table, max_servo_id, vendor, wire
+from gaitbot.bus.packets import status_frames, take_packets
+from gaitbot.bus.port import (PORT_EXCEPTIONS, close_quietly, is_pseudo_terminal, port_errors, read_pending,
+                              reply_timeout, reset_input)
+from gaitbot.bus.sdk_bus import SdkBus
+from gaitbot.servos import control_table, max_servo_id, model_name_of, vendor, wire
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
 
 #: dynamixel_sdk's broadcastPing window: status packets of 14 bytes from every id, 3 ms a servo, 16 ms latency.
@@ -69,37 +72,32 @@ class ProbeResult:
     damaged: int = 0
 
 
-def model_name_of(backend: str, number: int) -> str | None:
-    """The model with this model number on a ``backend`` bus (None: gaitbot does not know it)."""
-    for name, known in vendor(backend).MODEL_NUMBERS.items():
-        if known == number:
-            return name
-    return None
-
-
 class ProbeBus:
-    """A ``backend`` bus speaking ``protocol`` on ``port_handler`` (the SDK's PortHandler, a MockPort or a
-    recorder around either), its servos unknown. Open it, set a baud rate, then ``search`` / ``read`` /
-    ``write``. ``reply_timeout_ms`` replaces the SDK's reply timeout (about 34 ms) for every exchange."""
+    """A bus of the vendor of ``transport`` (its SdkBus class: the SDK module and the packet handler a walk
+    uses) speaking ``protocol`` on ``port_handler`` (the SDK's PortHandler, a dry-run port or a recorder
+    around either), its servos unknown. Open it, set a baud rate, then ``search`` / ``read`` / ``write``.
+    ``reply_timeout_ms`` replaces the SDK's reply timeout (about 34 ms) for every exchange."""
 
-    def __init__(self, backend: str, protocol: float, port_name: str, port_handler: Any,
+    def __init__(self, transport: type[SdkBus], protocol: float, port_name: str, port_handler: Any,
                  reply_timeout_ms: float | None = None, retries: int = 3) -> None:
-        self.backend = backend
+        self.transport = transport
+        self.backend = transport.family
+        self.vendor = vendor(self.backend)
         self.protocol = float(protocol)
         self.port_name = port_name
         self._inner_port = port_handler
-        self.port = _Tap(port_handler, wire.framing_for(backend, protocol))
+        self.framing = wire.framing_for(self.backend, protocol)
+        self.port = _Tap(port_handler, self.framing)
         self.reply_timeout_ms = reply_timeout_ms
         self.retries = retries
-        self.framing = wire.framing_for(backend, protocol)
-        self.sdk = _sdk(backend)
+        self.sdk = transport.sdk
         self._ph: Any = None
         self.baudrate: int | None = None
         self.open_notes: list[str] = []
 
     # --- the port ---------------------------------------------------------------------------
     def open(self) -> None:
-        self._ph = _packet_handler(self.backend, self.protocol)
+        self._ph = self.transport.make_packet_handler(self.protocol)  # words decoded here, in each servo's order
         try:
             opened = self.port.openPort()
         except PORT_EXCEPTIONS as exc:
@@ -108,10 +106,7 @@ class ProbeBus:
             raise PortError(f"cannot open serial port {self.port_name}")
 
     def close(self) -> None:
-        try:
-            self.port.closePort()
-        except PORT_EXCEPTIONS:
-            pass
+        close_quietly(self.port)
 
     def __enter__(self) -> "ProbeBus":
         self.open()
@@ -125,10 +120,8 @@ class ProbeBus:
         switches rate after a Baud Rate write, so the servo hears the whole write at the old rate."""
         serial_port = getattr(self._inner_port, "ser", None)
         if serial_port is not None:
-            try:
+            with port_errors(self.port, self.port_name):
                 serial_port.flush()
-            except PORT_EXCEPTIONS as exc:
-                raise PortError(f"serial port {self.port_name} failed: {exc}") from exc
         time.sleep(settle_s)
 
     def set_baudrate(self, baudrate: int) -> None:
@@ -148,10 +141,11 @@ class ProbeBus:
             raise RuntimeError("set a baud rate first")
         ids = ids if ids is not None else range(0, max_servo_id(self.backend, self.protocol) + 1)
         result = ProbeResult(self.baudrate)
-        if self.backend == "dynamixel" and self.protocol == 2.0:
+        broadcast = self.vendor.BROADCAST_PING.get(self.protocol)
+        if broadcast == "in turn":
             answered, result.damaged = self._broadcast_ping(all_at_once=False)
             numbers = answered
-        elif self.backend == "feetech":
+        elif broadcast == "at once":
             answered, result.damaged = self._broadcast_ping(all_at_once=True)
             if result.damaged or not answered:
                 numbers = {}
@@ -184,8 +178,7 @@ class ProbeBus:
         data = self._listen(window_ms, quiet_ms=self.reply_timeout_ms)
         answered: dict[int, int | None] = {}
         damaged = 0
-        for raw, is_packet in wire.split_complete(bytearray(data), self.framing):
-            frame = wire.parse(raw, self.framing, status=True) if is_packet else None
+        for _raw, frame in take_packets(bytearray(data), self.framing, status=True):
             if frame is None or not frame.checksum_ok:
                 damaged += 1
                 continue
@@ -223,11 +216,10 @@ class ProbeBus:
             try:
                 number, result, _error = self._guard(lambda: self._ph.ping(self.port, servo_id))
             except IndexError:  # dynamixel_sdk 1.0's ping indexes a model-number reply too short: a stale packet
-                self.port.is_using = False
                 self.port.seen.add(servo_id)  # it answered something: ask again with time to spare
                 return "silent", None
         if result == self.sdk.COMM_SUCCESS:
-            return "ok", (number if self.backend == "dynamixel" else None)
+            return "ok", (number if self.vendor.ONE_BYTE_ORDER else None)
         return ("damaged" if result == self.sdk.COMM_RX_CORRUPT else "silent"), None
 
     def ping(self, servo_id: int, timeout_ms: float = CONFIRM_TIMEOUT_MS) -> bool:
@@ -277,10 +269,10 @@ class ProbeBus:
     def model_number(self, servo_id: int) -> int | None:
         """The servo's model number from its Model Number register (Dynamixel address 0, Feetech 3, the
         word in the servo's own byte order: Feetech's END register at 2 says which)."""
-        table = control_table(next(iter(vendor(self.backend).CONTROL_TABLES)))
+        table = control_table(next(iter(self.vendor.CONTROL_TABLES)))
         register = table["Model Number"]
         try:
-            if self.backend == "feetech":
+            if not self.vendor.ONE_BYTE_ORDER:
                 end = table["Byte Order"].address
                 data, _ = self.read(servo_id, end, register.address + register.size - end)
                 order = "big" if data[0] else "little"
@@ -295,20 +287,15 @@ class ProbeBus:
         return self.reply_timeout_ms if self.reply_timeout_ms is not None else 2 * _USB_LATENCY_MS + 2.0
 
     def _timeout(self, timeout_ms: float | None):
-        return _ReplyTimeout(self._inner_port, timeout_ms if timeout_ms is not None else self.reply_timeout_ms)
+        return reply_timeout(self._inner_port, timeout_ms if timeout_ms is not None else self.reply_timeout_ms)
 
     def _guard(self, call):
-        try:
+        """One exchange (gaitbot.bus.port.port_errors: PortError, the SDK's lock released)."""
+        with port_errors(self.port, self.port_name):
             return call()
-        except PORT_EXCEPTIONS as exc:
-            self.port.is_using = False
-            raise PortError(f"serial port {self.port_name} failed: {exc}") from exc
 
     def _write(self, packet: bytes) -> None:
-        try:
-            self.port.writePort(list(packet))
-        except PORT_EXCEPTIONS as exc:
-            raise PortError(f"serial port {self.port_name} failed: {exc}") from exc
+        self._guard(lambda: self.port.writePort(list(packet)))
 
     def _listen(self, window_ms: float, quiet_ms: float | None) -> bytes:
         """Every byte within ``window_ms``; with ``quiet_ms``, stop once the line has been quiet that long after
@@ -334,22 +321,9 @@ class ProbeBus:
 
     def _drop_stale(self) -> set[int]:
         """Read and drop bytes left over from an earlier exchange; the ids of clean status packets among them."""
-        available = getattr(self.port, "getBytesAvailable", None)
-        ids: set[int] = set()
-        if callable(available):
-            pending = self._guard(available)
-            if pending:
-                stale = bytes(self._guard(lambda: self.port.readPort(pending)))
-                for raw, is_packet in wire.split_complete(bytearray(stale), self.framing):
-                    if is_packet:
-                        frame = wire.parse(raw, self.framing, status=True)
-                        if frame.checksum_ok:
-                            ids.add(frame.packet_id)
-        reset = getattr(self.port, "reset_input_buffer", None)
-        if callable(reset):
-            reset()
-        elif getattr(self.port, "ser", None) is not None:
-            self.port.ser.reset_input_buffer()
+        stale = self._guard(lambda: read_pending(self.port))
+        ids = {frame.packet_id for frame in status_frames(stale, self.framing) if frame.checksum_ok}
+        reset_input(self.port)
         return ids
 
 
@@ -372,63 +346,18 @@ class _Tap:
         data = self._inner.readPort(length)
         if data:
             self._pending += bytes(data)
-            for raw, is_packet in wire.split_complete(self._pending, self._framing):
-                if is_packet:
-                    frame = wire.parse(raw, self._framing, status=True)
-                    if frame.checksum_ok:
-                        self.seen.add(frame.packet_id)
-                    else:
-                        self.damaged += 1
+            for _raw, frame in take_packets(self._pending, self._framing, status=True):
+                if frame is None:
+                    continue
+                if frame.checksum_ok:
+                    self.seen.add(frame.packet_id)
+                else:
+                    self.damaged += 1
         return data
 
     def writePort(self, packet) -> int:  # noqa: N802
         self._pending.clear()  # a new exchange: what was half-read belongs to the last one
         return self._inner.writePort(packet)
-
-
-class _ReplyTimeout:
-    """Within the block, the port's reply timeout is ``timeout_ms`` beyond the packet's bytes (None: the SDK's)."""
-
-    def __init__(self, port: Any, timeout_ms: float | None) -> None:
-        self.port, self.timeout_ms = port, timeout_ms
-        self._saved: Any = None
-
-    def __enter__(self) -> None:
-        if self.timeout_ms is None or not hasattr(self.port, "tx_time_per_byte"):
-            return
-        self._saved = self.port.__dict__.get("setPacketTimeout")
-        port, timeout_ms = self.port, self.timeout_ms
-
-        def set_packet_timeout(packet_length):
-            port.packet_start_time = port.getCurrentTime()
-            port.packet_timeout = port.tx_time_per_byte * packet_length + timeout_ms
-
-        port.setPacketTimeout = set_packet_timeout
-
-    def __exit__(self, *exc) -> None:
-        if self.timeout_ms is None or not hasattr(self.port, "tx_time_per_byte"):
-            return
-        if self._saved is None:
-            del self.port.setPacketTimeout
-        else:
-            self.port.setPacketTimeout = self._saved
-
-
-def _sdk(backend: str):
-    if backend == "dynamixel":
-        import dynamixel_sdk
-        return dynamixel_sdk
-    import scservo_sdk
-    return scservo_sdk
-
-
-def _packet_handler(backend: str, protocol: float):
-    if backend == "dynamixel":
-        from gaitbot.bus.dynamixel import StuffingProtocol2PacketHandler
-        import dynamixel_sdk
-        return StuffingProtocol2PacketHandler() if float(protocol) == 2.0 else dynamixel_sdk.PacketHandler(1.0)
-    import scservo_sdk
-    return scservo_sdk.PacketHandler(0)  # words are decoded here, in each servo's own byte order
 
 
 __all__ = ["ProbeBus", "ProbeResult", "ServoFound", "model_name_of", "is_pseudo_terminal"]

@@ -1,4 +1,4 @@
-"""Limit checking of a recorded bus run (a ``gaitbot-bus-log`` JSON Lines file, read by gaitbot.bus.log).
+"""Limit checking of a recorded bus run (a ``gaitbot-bus-log`` JSON Lines file, gaitbot.bus.recording).
 
 A recording is checked in two layers: **the bus** (every packet well formed, every goal frame
 addressing exactly the configured ids, no unknown ids, the regularity of the goal frames against the
@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gaitbot.bus import log as bus_log
-from gaitbot.bus.log import BusLog, RecordedPacket, RecordingError, parse_packet, read_header, typed_header
+from gaitbot.bus import recording
+from gaitbot.bus.recording import BusLog, RecordingError, read_header, typed_header
 from gaitbot.check.health import HealthReport, health_report
 from gaitbot.check.settings import SettingWrite, describe_settings, setting_write
 from gaitbot.check.trajectory import CheckReport, check_trajectory
@@ -236,21 +236,21 @@ class _Logged:
 
 
 def read_log(path: str | Path, *, allow_partial_last_line: bool = False) -> tuple[dict, list[_Logged], list[BusIssue]]:
-    """A recording read by its format's reader (gaitbot.bus.log), as the checks take it: the typed header,
+    """A recording read by its format's reader (gaitbot.bus.recording), as the checks take it: the typed header,
     every packet line parsed, and file-level warnings. RecordingError (exit 2) for an unreadable file."""
-    log = bus_log.read_log(path, allow_partial_last_line=allow_partial_last_line)
+    log = recording.read_log(path, allow_partial_last_line=allow_partial_last_line)
     packets, notes = _packets(log)
     return typed_header(log.header), packets, notes
 
 
 def _packets(log: BusLog) -> tuple[list[_Logged], list[BusIssue]]:
-    """Every packet line of a log (gaitbot.bus.log, the format's reader) parsed, and file-level warnings."""
+    """Every packet line of a log (gaitbot.bus.recording, the format's reader) parsed, and file-level warnings."""
     packets = []
     for line in log.lines:
         if line.data is None:
             packets.append(_Logged(line.line_no, line.t_s, line.direction, line.hex, None, line.problem))
             continue
-        parsed = parse_packet(RecordedPacket(line.line_no, line.t_s, line.direction, line.data), log.framing)
+        parsed = line.packet
         packets.append(_Logged(line.line_no, line.t_s, line.direction, line.hex, parsed,
                                "" if parsed.checksum_ok else parsed.problem))
     notes = []

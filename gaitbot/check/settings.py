@@ -30,7 +30,7 @@ class SettingWrite:
 def setting_write(line_no: int, t_s: float, packet, model: ServoModel) -> SettingWrite | None:
     """The setting a tx packet writes (None for anything else: goals, torque, reads, sync packets).
 
-    ``packet`` is a checksum-valid ParsedPacket (gaitbot.bus.log)."""
+    ``packet`` is a checksum-valid ParsedPacket (gaitbot.bus.recording)."""
     if packet.instruction != wire.INST_WRITE or packet.address is None or not packet.data:
         return None
     address, length = packet.address, len(packet.data)

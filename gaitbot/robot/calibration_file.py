@@ -30,7 +30,7 @@ import dataclasses
 from pathlib import Path
 
 from gaitbot.fields import FieldError, Fields, kind, read_toml
-from gaitbot.robot.config import (ConfigCheck, RobotConfig, angle_outside_servo, default_config_path,
+from gaitbot.robot.config import (RobotConfig, angle_outside_servo, default_config_path,
                                   load_robot_config, resolve_config)
 
 FORMAT = "gaitbot-calibration"
@@ -132,12 +132,11 @@ def apply_calibration(config: RobotConfig, calibration: CalibrationFile) -> Robo
     return dataclasses.replace(config, joints=joints, calibration_file=calibration.path)
 
 
-def load_robot_with_calibration(robot: str | Path | None, calibration: str | Path | None = None, *,
-                                extra_checks: tuple[ConfigCheck, ...] | list[ConfigCheck] = ()) -> RobotConfig:
+def load_robot_with_calibration(robot: str | Path | None, calibration: str | Path | None = None) -> RobotConfig:
     """A robot config (a path, a shipped name, or the default robot) with its calibration applied: the file
     given, else ``<config stem>.calibration.toml`` beside the config when it exists, else none."""
     path = resolve_config(robot) if robot else default_config_path()
-    config = load_robot_config(path, extra_checks=extra_checks)
+    config = load_robot_config(path)
     found = Path(calibration) if calibration else calibration_path_for(path)
     if calibration or found.is_file():
         config = apply_calibration(config, read_calibration(found))

@@ -9,16 +9,14 @@ the file, the field and what is allowed::
 
 The file format is written down in docs/robot-config.md.
 
-Checks that need another room (whether the bus can carry ``gait.rate_hz`` frames at
-``bus.baudrate``: ``gaitbot.bus.budget``) are passed in by the caller through ``extra_checks``,
-because this module imports only from rooms to its left (gait -> robot -> bus -> stream).
+Whether the bus can carry ``gait.rate_hz`` frames at ``bus.baudrate`` is checked on load too, with the
+frame-budget arithmetic of the vendor facts (gaitbot.servos.budget): loading a robot runs no bus code.
 """
 
 from __future__ import annotations
 
 import difflib
 import math
-from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from functools import cached_property
 from importlib import resources
@@ -39,7 +37,8 @@ from gaitbot.gait.walker import WalkSettings, make_context
 from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
 from gaitbot.robot.gains import GainError, gain_for_error
 from gaitbot.robot.health import HealthSettings, read_health
-from gaitbot.servos import BACKENDS, dynamixel, feetech, max_servo_id, vendor
+from gaitbot.servos import BACKENDS, feetech, max_servo_id, vendor
+from gaitbot.servos.budget import FrameBudget, check_rate
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
 
 DEFAULT_ROBOT = "xl430-biped"
@@ -48,7 +47,7 @@ DEFAULT_ROBOT = "xl430-biped"
 class ConfigError(FieldError):
     """A robot config is unusable. The message is one line: ``<file>: <field>: <what is wrong>``.
 
-    Other modules that check a loaded config (the bus budget) build theirs with ``ConfigError(path,
+    Other modules that check a loaded config build theirs with ``ConfigError(path,
     field, reason)`` so every config complaint looks the same.
     """
 
@@ -244,10 +243,6 @@ class RobotConfig:
         raise KeyError(f"{self.path}: no joint {name!r} (joints: {', '.join(self.joint_names)})")
 
 
-# A check run on a loaded config; raises ConfigError. See load_robot_config(extra_checks=...).
-ConfigCheck = Callable[[RobotConfig], None]
-
-
 # ---------------------------------------------------------------------------------------------
 # Finding the shipped configs
 
@@ -304,19 +299,24 @@ def default_config_path() -> Path:
 # Loading
 
 
-def load_robot_config(path: str | Path, *, extra_checks: Iterable[ConfigCheck] = ()) -> RobotConfig:
-    """Read and validate a robot config; raise ConfigError (one line) on the first problem.
-
-    ``extra_checks`` are run on the validated config, in order; this is the hook for checks that
-    live in rooms to the right of this one, e.g. the integrator passes
-    ``gaitbot.bus.budget``'s check that the bus can carry ``gait.rate_hz`` frames per second.
-    """
+def load_robot_config(path: str | Path) -> RobotConfig:
+    """Read and validate a robot config; raise ConfigError (one line) on the first problem, including a
+    ``gait.rate_hz`` its bus cannot carry (:func:`check_bus_rate`)."""
     path = Path(path)
     data = read_toml(path, ConfigError)
     config = _Reader(path).robot(data)
-    for check in extra_checks:
-        check(config)
+    try:
+        check_bus_rate(config, config.gait.rate_hz)
+    except ValueError as exc:
+        raise ConfigError(config.path, "gait.rate_hz", str(exc)) from None
     return config
+
+
+def check_bus_rate(config: RobotConfig, rate_hz: float) -> FrameBudget:
+    """ValueError if ``config``'s bus cannot carry ``rate_hz`` frames per second with the read-back every
+    session makes (goal writes plus one servo's read, with margin: gaitbot.servos.budget.check_rate)."""
+    return check_rate(rate_hz, config.bus.backend, config.bus.protocol, config.joints[0].model, len(config.joints),
+                      config.bus.baudrate, read_back=True)
 
 
 #: Bounds of every size a config can ask for (value ranges, both ends included; the shipped robots sit
@@ -549,13 +549,14 @@ class _Reader(Fields):
         backend = self.string(t, "backend", f, f"one of {', '.join(map(repr, BACKENDS))}")
         if backend not in BACKENDS:
             raise self.fail("bus.backend", f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
-        protocol = feetech.PROTOCOLS[0]
-        if backend == "dynamixel":
-            allowed = " or ".join(str(p) for p in dynamixel.PROTOCOLS)
+        protocols = vendor(backend).PROTOCOLS
+        protocol = protocols[0]
+        if len(protocols) > 1:
+            allowed = " or ".join(str(p) for p in protocols)
             protocol = self.number(t, "protocol", f)
-            if protocol not in dynamixel.PROTOCOLS:
-                raise self.fail("bus.protocol", f"unknown Dynamixel protocol {protocol} (allowed: {allowed})")
-        # Feetech servos speak one protocol; a protocol key there is accepted and ignored (always 1.0).
+            if protocol not in protocols:
+                raise self.fail("bus.protocol", f"unknown {backend.capitalize()} protocol {protocol} (allowed: {allowed})")
+        # A vendor whose servos speak one protocol (Feetech): a protocol key is accepted and ignored (always 1.0).
         port = self.string(t, "port", f, "a serial port name, e.g. '/dev/ttyUSB0' or 'COM3'")
         rates = vendor(backend).SDK_BAUDRATES
         allowed_rates = ", ".join(str(r) for r in rates)

@@ -31,6 +31,14 @@ def vendor(backend: str) -> ModuleType:
         raise ValueError(f"unknown backend {backend!r} (known: {', '.join(BACKENDS)})") from None
 
 
+def model_name_of(backend: str, number: int) -> str | None:
+    """The model with this model number on a ``backend`` bus (None: gaitbot does not know it)."""
+    for name, known in vendor(backend).MODEL_NUMBERS.items():
+        if known == number:
+            return name
+    return None
+
+
 def max_servo_id(backend: str, protocol: float) -> int:
     """Highest usable servo id on a ``backend`` bus speaking ``protocol``."""
     return vendor(backend).MAX_ID[float(protocol)]

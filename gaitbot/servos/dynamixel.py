@@ -14,16 +14,23 @@ PROTOCOLS = (1.0, 2.0)
 BROADCAST_ID = 0xFE
 #: Highest usable id per protocol: 254 is broadcast on both; Protocol 2.0 reserves 253 (0xFD, a header byte).
 MAX_ID = {1.0: 253, 2.0: 252}
+#: dynamixel_sdk's PortHandler.clearPort drops pending input (the dry-run port behaves the same).
+SDK_CLEAR_PORT_DROPS_INPUT = True
 #: Baud rates dynamixel_sdk's PortHandler accepts, so a dry run refuses what a real run would refuse.
 SDK_BAUDRATES = (9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 576000, 921600, 1000000,
                  1152000, 2000000, 2500000, 3000000, 3500000, 4000000)
+#: Protocol -> how servos answer a broadcast ping: Protocol 2.0 servos one after another in id order
+#: (e-Manual Protocol 2.0, "Ping"); Protocol 1.0 has no broadcast ping (no status to id 254).
+BROADCAST_PING = {2.0: "in turn"}
+#: Every Dynamixel stores its words low byte first, so a word read without knowing the model is right.
+ONE_BYTE_ORDER = True
 #: Model numbers returned by ping and stored at "Model Number".
 MODEL_NUMBERS = {"XL430-W250": 1060, "XM430-W350": 1020, "XL-320": 350, "AX-12A": 12}
 #: Every Dynamixel leaves the factory at id 1 (e-Manual Protocol 1.0 / 2.0, "ID": "the default ID ... is 1").
 FACTORY_ID = 1
 
-# Control tables from the e-Manual (ROBOTIS-GIT/emanual docs/en/dxl/x/xl430-w250.md, xm430-w350.md,
-# xl320.md, ax/ax-12a.md; /work/proto/facts/vendor-facts.md section 2). ``factory`` is the value as shipped
+# Control tables from the ROBOTIS e-Manual pages "XL430-W250", "XM430-W350", "XL-320" and "AX-12/AX-12A"
+# (emanual.robotis.com, section "Control Table"). ``factory`` is the value as shipped
 # for settings; for the Present registers it is the value the emulator starts from (not a vendor fact).
 # X series (XL430-W250, XM430-W350): EEPROM 0..63, RAM from 64 (EEPROM writable only with torque off).
 _X_SERIES: ControlTable = {
@@ -96,8 +103,15 @@ ERRBIT_INPUT_VOLTAGE, ERRBIT_OVERHEATING, ERRBIT_OVERLOAD = 0x01, 0x04, 0x20
 V1_ERROR_BITS = {0x01: "input voltage", 0x02: "angle limit", 0x04: "overheating", 0x08: "range", 0x10: "checksum",
                  0x20: "overload", 0x40: "instruction"}
 V2_ALERT = 0x80
+#: Protocol -> the status error bit that means "read the Hardware Error Status register to know more".
+ALERT_BITS = {2.0: V2_ALERT}
 V2_ERROR_NUMBERS = {1: "result fail", 2: "instruction error", 3: "CRC error (the servo saw a damaged packet)",
                     4: "data range error", 5: "data length error", 6: "data limit error", 7: "access error"}
+#: Status Return Level: from this level every instruction gets a status packet, from READS_FROM reads do
+#: (a ping always does): 0 ping only, 1 reads too, 2 all (e-Manual, "Status Return Level").
+STATUS_RETURN_ALL_FROM, STATUS_RETURN_READS_FROM = 2, 1
+#: A REBOOT instruction clears the Hardware Error Status (e-Manual Protocol 2.0, "Reboot").
+REBOOT_CLEARS_HARDWARE_ERROR = True
 #: The error a servo answers an instruction it does not know with, per protocol.
 INSTRUCTION_ERROR = {1.0: 0x40, 2.0: 0x02}
 _X_HARDWARE_ERRORS = {0x01: "input voltage", 0x04: "overheating", 0x08: "motor encoder", 0x10: "electrical shock",

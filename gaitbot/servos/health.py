@@ -1,7 +1,9 @@
 """A servo's health as data: which registers say it, how to decode them, and the limits a servo keeps.
 
-Three kinds of fact, each written once here from the vendors' documents (/work/proto/facts/vendor-facts.md
-sections 2, 8 and 9 hold the sources):
+Three kinds of fact, each written once here from the vendors' published manuals (the ROBOTIS e-Manual's
+control-table pages of each model, "XL430-W250", "XM430-W350", "XL-320", "AX-12/AX-12A", and their
+specifications; Feetech's "SMS/STS series memory table" and "SCSCL series memory table" and the STS3215 /
+SCS0009 datasheets):
 
 * **The health block** of each model: the smallest contiguous run of control-table bytes holding present
   position, input voltage and temperature (and present load where the model has one), so that one READ
@@ -58,7 +60,7 @@ class HealthBlock:
 
 @lru_cache(maxsize=None)
 def health_block(model) -> HealthBlock:
-    """The health block of a servo model (a ServoModel), from its control table (vendor-facts.md section 8:
+    """The health block of a servo model (a ServoModel), from its control table (the control-table pages:
     XL430 126..146, 21 bytes; XM430 132..146, 15 (no load); XL-320 37..46, 10; AX 36..43, 8; STS/SCS 56..63, 8)."""
     model_name, byte_order = model.name, model.byte_order
     table = _table(model_name)
@@ -145,7 +147,7 @@ def _limits(model_name: str, min_input_v: float, max_input_v: float, source: str
     return ServoLimits(temperature_c, min_input_v, max_input_v, min_register_v, source)
 
 
-#: The servo models' own limits (vendor-facts.md section 9). Where sources disagree the safer figure is kept.
+#: The servo models' own limits (the e-Manual's specifications and Feetech's datasheets). Where sources disagree the safer figure is kept.
 SERVO_LIMITS: dict[str, ServoLimits] = {
     # Temperature Limit 72 C; recommended 6.5..12.0 V (Min Voltage Limit register 6.0 V)
     "XL430-W250": _limits("XL430-W250", 6.5, 12.0, "ROBOTIS e-Manual XL430-W250 (dxl_x_info.yml)"),

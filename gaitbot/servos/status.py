@@ -18,6 +18,15 @@ def hardware_error_address(model_name: str) -> int | None:
     return dynamixel.CONTROL_TABLES[model_name]["Hardware Error Status"].address
 
 
+def hardware_error_bits(model_name: str) -> dict[int, str]:
+    """Bit -> fault in words of a model's hardware error register (Dynamixel X and XL-320: Hardware Error
+    Status; Feetech: Servo Status); empty when the model has none (AX: errors come in every status)."""
+    for module in (dynamixel, feetech):
+        if model_name in module.CONTROL_TABLES:
+            return dict(module.HARDWARE_ERROR_BITS.get(model_name, {}))
+    return {}
+
+
 def _bits(value: int, names: dict[int, str]) -> list[str]:
     words = [name for bit, name in names.items() if value & bit]
     unknown = value & ~sum(names)

@@ -1,7 +1,7 @@
 """The simulation bus: the real Dynamixel/Feetech backend and SDK packet code on a port whose servos
 are the simulated robot's joints.
 
-SimPort is the mock port (gaitbot.bus.mock: parses every instruction packet and answers as the
+SimPort is the mock port (gaitbot.bus.dry_run: parses every instruction packet and answers as the
 servos would) with physics behind the control tables instead of ideal servos:
 
 * before each packet is handled, the physics advances to the clock's present time, so a goal
@@ -27,16 +27,16 @@ import numpy as np
 
 from gaitbot.bus.base import Bus
 from gaitbot.bus.factory import bus_class
-from gaitbot.bus.log import BusRecorder
-from gaitbot.bus.mock import MockPort
+from gaitbot.bus.recording import BusRecorder
+from gaitbot.bus.dry_run import DryRunPort
 from gaitbot.robot.calibration import angle_rad_to_ticks, ticks_to_angle_rad
 from gaitbot.robot.config import RobotConfig
 from gaitbot.servos.registers import overlaps
 from gaitbot.sim.physics import SimRobot
 
 
-class SimPort(MockPort):
-    """A MockPort whose walking servos are ``robot``'s joints, on the time ``now()`` tells (seconds)."""
+class SimPort(DryRunPort):
+    """A DryRunPort whose walking servos are ``robot``'s joints, on the time ``now()`` tells (seconds)."""
 
     def __init__(self, config: RobotConfig, robot: SimRobot, now: Callable[[], float], port_name: str = "sim") -> None:
         super().__init__(config.bus.backend, config.bus.protocol, config.models_by_id, port_name=port_name,
@@ -104,4 +104,4 @@ def make_sim_bus(config: RobotConfig, robot: SimRobot, now: Callable[[], float],
     if recorder is not None:
         handler = recorder.wrap(handler, backend=config.bus.backend, protocol=config.bus.protocol,
                                 baudrate=config.bus.baudrate, models=config.models_by_id)
-    return cls("sim", config.bus.baudrate, config.bus.protocol, config.models_by_id, port_handler=handler)
+    return cls("sim", config.bus.baudrate, config.bus.protocol, config.models_by_id, port_handler=handler, clock=now)

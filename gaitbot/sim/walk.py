@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from gaitbot.bus.base import Bus
-from gaitbot.bus.log import BusRecorder
+from gaitbot.bus.recording import BusRecorder
 from gaitbot.gait.walk_segments import CLEARANCE_WINDOW
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.config import RobotConfig

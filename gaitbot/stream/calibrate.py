@@ -73,7 +73,7 @@ def calibrate_session(bus: Bus, joints: Sequence[CalibrationJoint], *, ask: Call
     bus.open()
     try:
         prepare(bus, ids)
-        numbers = getattr(bus, "model_numbers", {})
+        numbers = bus.model_numbers
         for j in joints:
             number = numbers.get(j.id)
             if number is not None and number != j.model.model_number:

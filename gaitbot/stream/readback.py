@@ -112,7 +112,7 @@ class ReadBackMonitor:
             raise self.error(servo_id, misses, budget_s)
 
     def error(self, servo_id: int, misses: list[ReadBack], budget_s: float) -> ServoTimeout:
-        port = getattr(self.bus, "port_name", "the bus")
+        port = self.bus.port_name
         count = len(misses)
         budget_ms = max(0.0, budget_s) * 1e3
         late = [m.late_s for m in misses if m.late_s is not None]

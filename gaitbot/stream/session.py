@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite
-from gaitbot.bus.log import RecordingFailed
+from gaitbot.bus.recording import RecordingFailed
 from gaitbot.stream.clock import Clock, MonotonicClock
 from gaitbot.stream.health import HealthMonitor, ServoHealthStop
 from gaitbot.stream.pacing import FrameSource, StopRequestedError, StreamStats, Streamer, as_tick_frames, tick_frames
@@ -363,11 +363,8 @@ class WalkSession:
 
     def _explain(self, exc: BusError) -> BaseException:
         """The fault in words, read once the robot is safe (a bus may read the servo's error register)."""
-        explain = getattr(self.bus, "explain_status_error", None)
-        if not callable(explain):
-            return exc
         try:
-            return explain(exc)
+            return self.bus.explain_status_error(exc)
         except (KeyboardInterrupt, Terminated):
             return exc
 

@@ -18,10 +18,12 @@ import threading
 
 import pytest
 
-from gaitbot.bus import emulator as se
-from gaitbot.bus.log import decode_goal_frames
+import gaitbot.emulator as se
+from gaitbot.bus.recording import decode_goal_frames
 from gaitbot.robot.calibration_file import read_calibration
 from gaitbot.servos import baud_register_value, factory_baudrate
+from gaitbot.servos.health import health_block
+from gaitbot.servos.models import SERVO_MODELS
 from helpers import REPO_ROOT, config
 
 ROBOTS = {"dxl2": "xl430-biped", "dxl1": "ax12a-biped", "feetech": "sts3215-biped"}
@@ -160,7 +162,7 @@ def test_two_servos_on_a_protocol1_bus_are_refused_too():
 
 def test_a_servo_of_another_model_is_refused():
     robot = config("xl430-biped")
-    xl320 = se.SERVO_MODELS["XL-320"]
+    xl320 = SERVO_MODELS["XL-320"]
     with fresh_emulator(robot, models=(xl320,)) as emulator:
         code, out, err = setup(robot, emulator, [robot.joints[0].name])
         assert code == 2 and "is a XL-320" in err and "the config says XL430-W250" in err, err
@@ -226,7 +228,7 @@ def test_scan_lists_what_the_emulator_holds(protocol):
     servos = {s["id"]: s for s in result["servos"]}
     assert sorted(servos) == sorted(models)
     model = robot.joints[0].model
-    supply = se.health_block(model).voltage.factory / 10
+    supply = health_block(model).voltage.factory / 10
     for servo_id, s in servos.items():
         joint = next(j for j in robot.joints if j.id == servo_id)
         assert (s["model"], s["baudrate"], s["joint"], s["torque"]) == (joint.model.name, robot.bus.baudrate,

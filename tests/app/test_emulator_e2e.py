@@ -18,10 +18,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gaitbot.bus.log import decode_goal_frames
+from gaitbot.bus.recording import decode_goal_frames
 from gaitbot.robot.config import load_robot_config
 
-from gaitbot.bus import emulator as se  # noqa: E402 - the emulator, imported as a module
+import gaitbot.emulator as se  # noqa: E402 - the emulator, imported as a module
 from helpers import REPO_ROOT, emulator_for, gaitbot
 
 ROOT = REPO_ROOT

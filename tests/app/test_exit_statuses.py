@@ -18,7 +18,7 @@ import re
 import pytest
 
 from gaitbot.app.cli import main
-from gaitbot.bus import emulator as se
+import gaitbot.emulator as se
 from helpers import CONFIG_DIR, config, emulator_for, run_cli
 
 

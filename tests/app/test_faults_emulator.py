@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gaitbot.bus import emulator as se
-from gaitbot.bus.log import decode_goal_frames
+import gaitbot.emulator as se
+from gaitbot.bus.recording import decode_goal_frames
 from gaitbot.check.trajectory import check_trajectory
 from gaitbot.robot.calibration import ticks_to_angles
 from gaitbot.robot.config import load_robot_config

@@ -34,7 +34,7 @@ from gaitbot.robot.calibration import angles_to_ticks
 from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 from gaitbot.app.options import load_robot
 
-from gaitbot.bus import emulator as se  # noqa: E402 - the emulator, imported as a module
+import gaitbot.emulator as se  # noqa: E402 - the emulator, imported as a module
 from helpers import REPO_ROOT
 
 ROOT = REPO_ROOT
@@ -58,7 +58,7 @@ def record_in_process(config, ticks, out: Path, extra: int = 5):
     """Record len(ticks) + extra samples through the SDK on the emulator's pty, on a virtual clock."""
     with emulator(config, ticks) as emu:
         bus = make_bus(config.bus.backend, config.bus.protocol, emu.path, config.bus.baudrate, config.models_by_id,
-                       dry_run=False, reply_timeout_ms=REPLY_TIMEOUT_MS)
+                       interface="serial", reply_timeout_ms=REPLY_TIMEOUT_MS)
         result = record_session(bus, config.ids, 1.0 / config.gait.rate_hz, TrajectorySink(config, out, print),
                                 confirm=lambda n: True, n_samples=len(ticks) + extra, clock=VirtualClock())
     assert result.outcome == "completed", result.message()

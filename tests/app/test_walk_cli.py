@@ -67,7 +67,7 @@ def test_dry_run_recording_matches_generate(config_path, tmp_path, capsys):
     assert abs(periods.mean() - 1 / 60) < 0.01 / 60
     trajectory = Trajectory.load(csv)
     # Before the walk the session ramps every servo from where it is to the walk's first pose. The mock's
-    # servos start at their model's centre tick (gaitbot/bus/mock.py), and a pose at most 1 tick away is
+    # servos start at their model's centre tick (gaitbot/bus/dry_run.py), and a pose at most 1 tick away is
     # not worth a ramp (gaitbot/stream/ramps.py): so no ramp where the first pose is the centre (zero_tick
     # at the centre, as on the pitch-only robots), a ramp where it is not (bioloid: its zero_ticks sit off
     # the centre by the legs' dog-leg offsets).

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gaitbot.bus.log import decode_goal_frames, read_recording
+from gaitbot.bus.recording import decode_goal_frames, read_recording
 
 STAND_TICKS = 2048  # xl430-biped: every joint's zero_tick, the standing pose
 

@@ -6,7 +6,7 @@ import dynamixel_sdk
 
 from gaitbot.bus import PortError, ServoTimeout
 from gaitbot.bus.dynamixel import DynamixelBus, StuffingProtocol2PacketHandler
-from gaitbot.bus.mock import MockPort
+from gaitbot.bus.dry_run import DryRunPort
 from gaitbot.servos.models import SERVO_MODELS
 
 XM = SERVO_MODELS["XM430-W350"]  # same X-series layout as the XM430-W210 used in the e-Manual examples
@@ -33,7 +33,7 @@ def with_crc(body: bytes) -> bytes:
 
 
 def open_bus(protocol, models, baudrate=1_000_000):
-    port = MockPort("dynamixel", protocol, models)
+    port = DryRunPort("dynamixel", protocol, models)
     bus = DynamixelBus("mock", baudrate, protocol, models, port_handler=port)
     bus.open()
     return bus, port
@@ -85,7 +85,7 @@ def test_protocol2_torque_enable_write():
 
 def test_protocol2_byte_stuffing_reaches_the_wire():
     """FF FF FD inside the data must go out as FF FF FD FD, with LENGTH and CRC over the stuffed bytes."""
-    port = MockPort("dynamixel", 2.0, {1: XM})
+    port = DryRunPort("dynamixel", 2.0, {1: XM})
     handler = StuffingProtocol2PacketHandler()
     result, error = handler.writeTxRx(port, 1, 224, 3, [0xFF, 0xFF, 0xFD])  # Indirect Data 1..3
     assert (result, error) == (dynamixel_sdk.COMM_SUCCESS, 0)
@@ -128,7 +128,7 @@ def test_lost_status_packet_is_retried_not_fatal():
 
 
 def test_read_gives_up_after_bounded_retries():
-    port = MockPort("dynamixel", 2.0, {1: XM})
+    port = DryRunPort("dynamixel", 2.0, {1: XM})
     bus = DynamixelBus("mock", 1_000_000, 2.0, {1: XM}, port_handler=port, retries=2)
     bus.open()
     port.drop_next_replies(3)
@@ -152,16 +152,16 @@ def test_goal_outside_model_range_is_refused():
 
 def test_models_with_different_layouts_cannot_share_a_bus():
     with pytest.raises(ValueError, match="different addresses"):
-        DynamixelBus("mock", 1_000_000, 1.0, {1: XM, 2: AX}, port_handler=MockPort("dynamixel", 1.0, {}))
+        DynamixelBus("mock", 1_000_000, 1.0, {1: XM, 2: AX}, port_handler=DryRunPort("dynamixel", 1.0, {}))
 
 
 def test_protocol_the_servo_does_not_speak_is_refused():
     with pytest.raises(ValueError, match="does not speak protocol 2.0"):
-        DynamixelBus("mock", 1_000_000, 2.0, {1: AX}, port_handler=MockPort("dynamixel", 2.0, {}))
+        DynamixelBus("mock", 1_000_000, 2.0, {1: AX}, port_handler=DryRunPort("dynamixel", 2.0, {}))
 
 
 def test_unsupported_baud_rate_is_a_port_error():
-    port = MockPort("dynamixel", 2.0, {1: XM})
+    port = DryRunPort("dynamixel", 2.0, {1: XM})
     with pytest.raises(PortError, match="12345 baud"):
         DynamixelBus("mock", 12345, 2.0, {1: XM}, port_handler=port).open()
 

@@ -5,7 +5,7 @@ import pytest
 from scservo_sdk import scservo_def
 
 from gaitbot.bus.feetech import FeetechBus
-from gaitbot.bus.mock import MockPort
+from gaitbot.bus.dry_run import DryRunPort
 from gaitbot.servos.models import SERVO_MODELS
 
 STS = SERVO_MODELS["STS3215"]
@@ -17,7 +17,7 @@ def h(text: str) -> bytes:
 
 
 def open_bus(models):
-    port = MockPort("feetech", 1.0, models)
+    port = DryRunPort("feetech", 1.0, models)
     bus = FeetechBus("mock", 1_000_000, 1.0, models, port_handler=port)
     bus.open()
     return bus, port
@@ -65,7 +65,7 @@ def test_torque_enable_write():
 
 def test_mixing_byte_orders_on_one_bus_is_refused():
     with pytest.raises(ValueError, match="SCS_END"):
-        FeetechBus("mock", 1_000_000, 1.0, {1: STS, 5: SCS}, port_handler=MockPort("feetech", 1.0, {}))
+        FeetechBus("mock", 1_000_000, 1.0, {1: STS, 5: SCS}, port_handler=DryRunPort("feetech", 1.0, {}))
 
 
 def test_byte_order_global_is_set_on_open_and_reasserted_per_exchange():

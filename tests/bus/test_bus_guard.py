@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gaitbot.bus.factory import make_mock_bus
+from gaitbot.bus.factory import make_dry_run_bus
 from gaitbot.bus.guard import GoalOutsideLimits, LimitGuard
 from gaitbot.stream.clock import VirtualClock
 from gaitbot.robot.calibration import tick_limits
@@ -25,7 +25,7 @@ def test_tick_limits_from_degrees():
 
 
 def test_guard_refuses_before_sending():
-    bus = make_mock_bus("dynamixel", 2.0, {1: XL430, 2: XL430})
+    bus = make_dry_run_bus("dynamixel", 2.0, {1: XL430, 2: XL430})
     guarded = LimitGuard(bus, {1: (1000, 3000), 2: (1000, 3000)}, {1: "hip", 2: "knee"})
     with guarded:
         guarded.write_goal_ticks({1: 2000, 2: 2500})
@@ -38,7 +38,7 @@ def test_guard_refuses_before_sending():
 def test_session_with_a_servo_outside_its_limits_moves_nothing():
     # the mock chain starts at the centre tick 2048; limits 2100..2300 put every servo outside
     models = {i: XL430 for i in (1, 2, 3)}
-    bus = make_mock_bus("dynamixel", 2.0, models)
+    bus = make_dry_run_bus("dynamixel", 2.0, models)
     guarded = LimitGuard(bus, {i: (2100, 2300) for i in models})
     frames = np.full((10, 3), 2200)
     result = walk_session(guarded, [1, 2, 3], frames, np.full(3, 2200), max_velocity_ticks_per_s=3000,
@@ -46,3 +46,17 @@ def test_session_with_a_servo_outside_its_limits_moves_nothing():
     assert result.exit_code == 1 and isinstance(result.error, GoalOutsideLimits)
     goal_writes = [p for p in bus.port.tx_packets if p[7] == 0x83]  # sync write instruction (protocol 2.0)
     assert goal_writes == []
+
+
+def test_a_bus_layer_passes_on_every_ability_of_the_bus():
+    """BusLayer (the LimitGuard's base) overrides every public method and attribute the Bus declares, so a
+    layer never silently falls back to a Bus default instead of asking the bus under it."""
+    import inspect
+
+    from gaitbot.bus.base import Bus, BusLayer
+
+    declared = {name for name, value in vars(Bus).items() if not name.startswith("_")}
+    missing = sorted(name for name in declared if name not in vars(BusLayer))
+    assert not missing, f"BusLayer does not pass on {missing}"
+    assert {"write_goal_ticks", "read_back", "explain_status_error", "open_notes"} <= declared
+    assert not any(inspect.isfunction(v) and k == "__getattr__" for k, v in vars(BusLayer).items())

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gaitbot.bus import make_bus
-from gaitbot.bus.log import (BusRecorder, RecordingError, decode_goal_frames, parse_recording,
+from gaitbot.bus.recording import (BusRecorder, RecordingError, decode_goal_frames, parse_recording,
                                    read_recording)
 from gaitbot.servos.models import SERVO_MODELS
 
@@ -21,7 +21,7 @@ def fake_clock(step_s=0.01):
 def record_run(path, backend="dynamixel", protocol=2.0, name="XL430-W250", frames=((1000, 2000), (1010, 1990))):
     model = SERVO_MODELS[name]
     recorder = BusRecorder(path, robot="testbot", joints=JOINTS, clock=fake_clock())
-    bus = make_bus(backend, protocol, "/dev/ttyUSB0", 1_000_000, {1: model, 2: model}, dry_run=True,
+    bus = make_bus(backend, protocol, "/dev/ttyUSB0", 1_000_000, {1: model, 2: model}, interface="dry-run",
                    recorder=recorder)
     with bus:
         bus.set_torque([1, 2], True)
@@ -74,7 +74,7 @@ def test_every_line_is_on_disk_before_close(tmp_path):
     path = tmp_path / "live.jsonl"
     model = SERVO_MODELS["STS3215"]
     recorder = BusRecorder(path, robot="testbot", joints={"a": 1}, clock=fake_clock())
-    bus = make_bus("feetech", 1.0, "p", 1_000_000, {1: model}, dry_run=True, recorder=recorder)
+    bus = make_bus("feetech", 1.0, "p", 1_000_000, {1: model}, interface="dry-run", recorder=recorder)
     bus.open()
     bus.write_goal_ticks({1: 100})
     lines = path.read_text().splitlines()  # bus still open, recorder not closed

@@ -2,7 +2,7 @@
 them, a late reply to an abandoned read is never taken as the answer to a later one, the wait never
 outlasts its budget, and the monitor names the servo that keeps missing.
 
-The chain is MockPort (the SDK's real packet code runs on top); faults come from small subclasses
+The chain is DryRunPort (the SDK's real packet code runs on top); faults come from small subclasses
 that hold a reply back, or never answer, in real or virtual time.
 """
 
@@ -14,7 +14,7 @@ import pytest
 
 from gaitbot.bus.base import CorruptReplies, ReadBack, ServoLate, ServoStatusError, ServoTimeout
 from gaitbot.bus.factory import bus_class
-from gaitbot.bus.mock import MockPort
+from gaitbot.bus.dry_run import DryRunPort
 from gaitbot.servos.models import servo_model
 from gaitbot.stream.clock import VirtualClock
 from gaitbot.stream.readback import READ_BACK_MISSES, READ_BACK_SILENCE_S, ReadBackMonitor
@@ -23,7 +23,7 @@ XL430 = servo_model("XL430-W250")
 AX12 = servo_model("AX-12A")
 
 
-class HoldingPort(MockPort):
+class HoldingPort(DryRunPort):
     """Holds back the status packets of ``held`` servos until the next instruction is written: the reply to
     one request then arrives in the middle of the next exchange, as a late servo's would."""
 
@@ -49,7 +49,7 @@ class HoldingPort(MockPort):
         super()._reply(servo_id, params)
 
 
-class SilentRealTimePort(MockPort):
+class SilentRealTimePort(DryRunPort):
     """A chain where ``silent`` servos never answer and the packet timeout runs on the real clock."""
 
     def __init__(self, *args, **kwargs) -> None:

@@ -15,7 +15,7 @@ import pytest
 
 from gaitbot.check.recording import (MAX_GAP_PERIODS, BusIssue, _frame_timing, _motion_samples, check_recording,
                                      match_config, read_log)
-from gaitbot.bus.log import RecordingError
+from gaitbot.bus.recording import RecordingError
 from helpers import (PERIOD_S, ROBOTS, build_sync_write, config, goal_layout, goal_line_indices,
                                 goal_row_near, read_lines, run_cli, split_sync_write, write_lines)
 
@@ -378,7 +378,7 @@ def test_check_reads_every_health_read_back_also_the_longer_ones_after_a_miss(tm
     more (the read-back's length rule, docs/bus-faults.md), and that answer is a health reading as well: check
     decodes exactly the readings the walk's monitor saw, the longer ones included."""
     from gaitbot.bus.factory import make_bus
-    from gaitbot.bus.log import BusRecorder
+    from gaitbot.bus.recording import BusRecorder
     from gaitbot.robot.calibration import standing_ticks
     from gaitbot.robot.walk_settings import joint_limits_ticks
     from gaitbot.servos import wire
@@ -393,8 +393,8 @@ def test_check_reads_every_health_read_back_also_the_longer_ones_after_a_miss(tm
     recorder = BusRecorder(path, robot=robot.name, joints={j.name: j.id for j in robot.joints}, clock=clock.now,
                            rate_hz=robot.gait.rate_hz)
     bus = make_bus(robot.bus.backend, robot.bus.protocol, "mock", robot.bus.baudrate, robot.models_by_id,
-                   dry_run=True, recorder=recorder)
-    mock = bus.port._inner  # the MockPort under the recording port
+                   interface="dry-run", recorder=recorder)
+    mock = bus.port._inner  # the DryRunPort under the recording port
     monitor = HealthMonitor.for_robot(robot, clock=clock.now)
 
     def on_frame(k, _stats):

@@ -404,21 +404,7 @@ def test_section_of_wrong_shape(tmp_path):
     expect_error(tmp_path, text, "robot", "table")
 
 
-# --- the hook for checks that live to the right (bus budget) -------------------------------------
-
-
-def test_extra_checks_run_on_the_loaded_config():
-    seen = []
-
-    def bus_budget(config: RobotConfig) -> None:
-        seen.append(config.gait.rate_hz)
-        if config.gait.rate_hz * 1000 > config.bus.baudrate / 100:
-            raise ConfigError(config.path, "gait.rate_hz", "the bus cannot carry this rate (test)")
-
-    with pytest.raises(ConfigError) as info:
-        load_robot_config(default_config_path(), extra_checks=[bus_budget])
-    assert seen == [60.0]
-    assert str(info.value) == f"{default_config_path()}: gait.rate_hz: the bus cannot carry this rate (test)"
+# --- the bus frame budget, checked on load with the vendor facts (no bus code) ---------------------
 
 
 def test_config_module_does_not_import_the_bus_room():
@@ -429,25 +415,15 @@ def test_config_module_does_not_import_the_bus_room():
 
 
 @pytest.mark.parametrize("name", SHIPPED)
-def test_shipped_configs_fit_the_bus_frame_budget_through_the_hook(tmp_path, name):
-    """The wiring the CLI is expected to use: the bus room's rate check, adapted to a ConfigError,
-    passed as an extra check. Every shipped robot must carry 60 Hz with read-back at 1 Mbaud,
-    and none can at 9600 baud (8 servos x ~14 bytes x 10 bits > 0.7 x 16.7 ms)."""
-    budget = pytest.importorskip("gaitbot.bus.budget")
-
-    def bus_can_carry_rate(config: RobotConfig) -> None:
-        try:
-            budget.check_rate(config.gait.rate_hz, config.bus.backend, config.bus.protocol,
-                              config.joints[0].model, len(config.joints), config.bus.baudrate, read_back=True)
-        except ValueError as exc:
-            raise ConfigError(config.path, "gait.rate_hz", str(exc)) from None
-
-    load_robot_config(resolve_config(name), extra_checks=[bus_can_carry_rate])
-    slow = shipped_text(name).replace("baudrate = 1000000", "baudrate = 9600")
-    with pytest.raises(ConfigError, match="gait.rate_hz"):
-        path = tmp_path / "slow.toml"
-        path.write_text(slow)
-        load_robot_config(path, extra_checks=[bus_can_carry_rate])
+def test_shipped_configs_fit_the_bus_frame_budget_on_load(tmp_path, name):
+    """Every shipped robot carries 60 Hz with read-back at its baud rate, and none can at 9600 baud
+    (8 servos x ~14 bytes x 10 bits > 0.7 x 16.7 ms): refused on load, naming gait.rate_hz."""
+    load_robot_config(resolve_config(name))
+    slow = re.sub(r"(?m)^baudrate = \d+", "baudrate = 9600", shipped_text(name))
+    path = tmp_path / "slow.toml"
+    path.write_text(slow)
+    with pytest.raises(ConfigError, match=r"gait\.rate_hz: .* too fast for .* at 9600 baud"):
+        load_robot_config(path)
 
 
 # --- the simulated robot's tables: [mass], [servo], heel_back_m -----------------------------------

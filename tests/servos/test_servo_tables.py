@@ -10,7 +10,7 @@ import pytest
 from gaitbot.bus.dynamixel import DynamixelBus
 from gaitbot.bus.factory import BUS_CLASSES
 from gaitbot.bus.feetech import FeetechBus
-from gaitbot.bus.mock import MockPort
+from gaitbot.bus.dry_run import DryRunPort
 from gaitbot.servos import BACKENDS, VENDORS, control_table, dynamixel, feetech, max_servo_id, wire
 from gaitbot.servos.models import SERVO_MODELS
 from gaitbot.servos.registers import overlaps
@@ -54,7 +54,7 @@ def test_id_ranges_per_protocol_agree_between_config_and_bus():
     for cls, protocol, model, top in ((DynamixelBus, 2.0, SERVO_MODELS["XL430-W250"], 252),
                                       (DynamixelBus, 1.0, SERVO_MODELS["AX-12A"], 253),
                                       (FeetechBus, 1.0, SERVO_MODELS["STS3215"], 253)):
-        port = MockPort(cls.family, protocol, {top: model})
+        port = DryRunPort(cls.family, protocol, {top: model})
         cls("mock", 1_000_000, protocol, {top: model}, port_handler=port)  # accepted
         with pytest.raises(ValueError, match=f"outside 0..{top}"):
             cls("mock", 1_000_000, protocol, {top + 1: model}, port_handler=port)
@@ -63,7 +63,7 @@ def test_id_ranges_per_protocol_agree_between_config_and_bus():
 def test_sdk_baud_rates_are_the_vendors():
     assert 1_000_000 in dynamixel.SDK_BAUDRATES and 4_000_000 in dynamixel.SDK_BAUDRATES
     assert 1_000_000 in feetech.SDK_BAUDRATES and 4_000_000 not in feetech.SDK_BAUDRATES
-    assert not MockPort("feetech", 1.0, {}).setBaudRate(4_000_000)
+    assert not DryRunPort("feetech", 1.0, {}).setBaudRate(4_000_000)
 
 
 def test_table_crc_is_the_emanual_crc():

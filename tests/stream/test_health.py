@@ -9,7 +9,7 @@ import re
 import numpy as np
 import pytest
 
-from gaitbot.bus.factory import make_mock_bus
+from gaitbot.bus.factory import make_dry_run_bus
 from gaitbot.servos.health import HealthReading, default_thresholds
 from gaitbot.stream.clock import VirtualClock
 from gaitbot.stream.health import HealthMonitor, ServoHealthStop
@@ -69,7 +69,7 @@ def test_the_monitor_warns_once_per_servo_and_kind_and_stops_at_a_stop_threshold
 
 
 def hot_bus(robot, servo_id, temperature_c=None, voltage_v=None):
-    bus = make_mock_bus(robot.bus.backend, robot.bus.protocol, robot.models_by_id)
+    bus = make_dry_run_bus(robot.bus.backend, robot.bus.protocol, robot.models_by_id)
     table = bus.port.tables[servo_id]
     if temperature_c is not None:
         table[146] = int(temperature_c)

@@ -33,13 +33,13 @@ TICKS_PER_DEG = 4096 / 360.0
 
 
 def guarded_mock_bus():
-    bus = make_bus("dynamixel", 2.0, "mock", 1_000_000, CFG.models_by_id, dry_run=True)
+    bus = make_bus("dynamixel", 2.0, "mock", 1_000_000, CFG.models_by_id, interface="dry-run")
     return LimitGuard(bus, tick_limits(CFG), {j.id: j.name for j in CFG.joints})
 
 
 def set_present(bus, ticks) -> None:
     for servo_id, tick in zip(IDS, ticks):
-        bus.port.tables[servo_id][PRESENT_ADDR:PRESENT_ADDR + 4] = int(tick).to_bytes(4, "little", signed=True)
+        bus.inner.port.tables[servo_id][PRESENT_ADDR:PRESENT_ADDR + 4] = int(tick).to_bytes(4, "little", signed=True)
 
 
 def hand_ticks(n: int) -> np.ndarray:
@@ -54,7 +54,7 @@ def hand_ticks(n: int) -> np.ndarray:
 def instructions(bus) -> list[tuple[int, int, bytes]]:
     """(instruction, packet id, params) of every packet the host sent."""
     out = []
-    for raw in bus.port.tx_packets:
+    for raw in bus.inner.port.tx_packets:
         frame = wire.parse(raw, "v2", status=False)
         out.append((frame.instruction, frame.packet_id, bytes(frame.params)))
     return out
@@ -169,7 +169,7 @@ def test_a_bus_error_stops_with_exit_1_the_file_complete_and_torque_off(tmp_path
         def add(self, t_s, ticks_now):
             super().add(t_s, ticks_now)
             if self.k == 40:
-                self.bus.port.drop_next_replies(10_000)  # the chain goes silent
+                self.bus.inner.port.drop_next_replies(10_000)  # the chain goes silent
 
     result = record_session(bus, IDS, PERIOD_S, DyingSink(out, bus, ticks), confirm=lambda n: True,
                             n_samples=100, clock=VirtualClock())
@@ -191,7 +191,7 @@ def test_hold_writes_the_present_pose_as_goal_then_torque_on(tmp_path):
                  if inst == wire.INST_WRITE and p[0] | p[1] << 8 == TORQUE_ADDR and p[2] == 1]
     assert len(torque_on) == len(IDS) and min(torque_on) > goal_at  # goal first, then torque on
     for servo_id, tick in zip(IDS, ticks[59]):
-        goal = bus.port.tables[servo_id][116:120]
+        goal = bus.inner.port.tables[servo_id][116:120]
         assert int.from_bytes(goal, "little", signed=True) == tick
 
 

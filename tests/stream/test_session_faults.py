@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from gaitbot.bus.factory import guarded, make_bus
-from gaitbot.bus.log import BusRecorder, read_log
-from gaitbot.bus.mock import MockPort
+from gaitbot.bus.recording import BusRecorder, read_log
+from gaitbot.bus.dry_run import DryRunPort
 from gaitbot.check.recording import check_recording
 from gaitbot.gait.walker import generate_walk
 from gaitbot.robot.calibration import angles_to_ticks, standing_ticks
@@ -29,8 +29,8 @@ from helpers import CONFIG_DIR
 FAULT_FRAME = 100
 
 
-class FaultyChain(MockPort):
-    """MockPort whose ``silent`` servos stop answering and whose ``damaged`` servos send bad checksums."""
+class FaultyChain(DryRunPort):
+    """DryRunPort whose ``silent`` servos stop answering and whose ``damaged`` servos send bad checksums."""
 
     silent: set[int] = set()
     damaged: set[int] = set()
@@ -63,9 +63,9 @@ def faulty_walk(tmp_path, robot: str, fault: str, victim: int, monkeypatch, reco
         chains.append(port)
         return port
 
-    monkeypatch.setattr("gaitbot.bus.factory.MockPort", chain)
+    monkeypatch.setattr("gaitbot.bus.factory.DryRunPort", chain)
     bus = guarded(config, make_bus(config.bus.backend, config.bus.protocol, "mock", config.bus.baudrate,
-                                   config.models_by_id, dry_run=True, recorder=recorder))
+                                   config.models_by_id, interface="dry-run", recorder=recorder))
     if recorder_fails_after is not None:
         fail_file_after(recorder, recorder_fails_after)
 

@@ -19,8 +19,8 @@ from gaitbot.bus.dynamixel import DynamixelBus
 from gaitbot.bus.factory import make_bus
 from gaitbot.bus.feetech import FeetechBus
 from gaitbot.bus.guard import LimitGuard
-from gaitbot.bus.mock import MockPort
-from gaitbot.bus.log import BusRecorder
+from gaitbot.bus.dry_run import DryRunPort
+from gaitbot.bus.recording import BusRecorder
 from gaitbot.check.recording import check_recording
 from gaitbot.app.cli import main
 from gaitbot.stream.clock import VirtualClock
@@ -109,7 +109,7 @@ def recorded_hold(tmp_path: Path, hold: bool) -> list[tuple[int, int, bytes]]:
     config = load_robot_config(CONFIG_DIR / "xl430-biped.toml")
     path = tmp_path / "bus.jsonl"
     recorder = BusRecorder(path, robot=config.name, joints={j.name: j.id for j in config.joints})
-    bus = make_bus("dynamixel", 2.0, "mock", 1_000_000, config.models_by_id, dry_run=True, recorder=recorder)
+    bus = make_bus("dynamixel", 2.0, "mock", 1_000_000, config.models_by_id, interface="dry-run", recorder=recorder)
     bus = LimitGuard(bus, tick_limits(config), {j.id: j.name for j in config.joints})
 
     class Sink:
@@ -139,7 +139,7 @@ def test_record_without_hold_writes_no_gain(tmp_path):
 # --- the bus method, byte for byte -------------------------------------------------------------------
 
 def test_protocol2_gain_write_by_hand():
-    port = MockPort("dynamixel", 2.0, {1: XM})
+    port = DryRunPort("dynamixel", 2.0, {1: XM})
     bus = DynamixelBus("mock", 1_000_000, 2.0, {1: XM}, port_handler=port)
     bus.open()
     bus.write_register([1], 84, 2, 4978)
@@ -151,13 +151,13 @@ def test_protocol2_gain_write_by_hand():
 
 
 def test_protocol1_gain_writes_by_hand():
-    port = MockPort("dynamixel", 1.0, {1: AX})
+    port = DryRunPort("dynamixel", 1.0, {1: AX})
     bus = DynamixelBus("mock", 1_000_000, 1.0, {1: AX}, port_handler=port)
     bus.open()
     assert (port.tables[1][28], port.tables[1][29]) == (32, 32)  # factory slopes
     bus.write_register([1], 28, 1, 4)
     assert port.tx_packets == [bytes.fromhex("FF FF 01 04 03 1C 04 D7")]  # ~(01+04+03+1C+04) = ~0x28
-    port = MockPort("feetech", 1.0, {1: STS})
+    port = DryRunPort("feetech", 1.0, {1: STS})
     bus = FeetechBus("mock", 1_000_000, 1.0, {1: STS}, port_handler=port)
     bus.open()
     assert port.tables[1][21] == 32  # factory P coefficient
@@ -166,7 +166,7 @@ def test_protocol1_gain_writes_by_hand():
 
 
 def test_a_lost_status_packet_is_retried_and_a_silent_servo_named():
-    port = MockPort("dynamixel", 2.0, {1: XM})
+    port = DryRunPort("dynamixel", 2.0, {1: XM})
     bus = DynamixelBus("mock", 1_000_000, 2.0, {1: XM}, port_handler=port, retries=2)
     bus.open()
     port.drop_next_replies(1)
@@ -179,7 +179,7 @@ def test_a_lost_status_packet_is_retried_and_a_silent_servo_named():
 
 
 def test_a_servo_reporting_an_error_on_the_gain_write_stops_it():
-    port = MockPort("dynamixel", 1.0, {1: AX})
+    port = DryRunPort("dynamixel", 1.0, {1: AX})
     bus = DynamixelBus("mock", 1_000_000, 1.0, {1: AX}, port_handler=port)
     bus.open()
 
@@ -196,7 +196,7 @@ def test_a_servo_reporting_an_error_on_the_gain_write_stops_it():
 
 @pytest.mark.parametrize("address, length", [(116, 4), (114, 4), (64, 1), (63, 2)])
 def test_goal_and_torque_registers_cannot_be_written_as_settings(address, length):
-    port = MockPort("dynamixel", 2.0, {1: XM})
+    port = DryRunPort("dynamixel", 2.0, {1: XM})
     bus = LimitGuard(DynamixelBus("mock", 1_000_000, 2.0, {1: XM}, port_handler=port), {1: (1000, 3000)})
     bus.open()
     with pytest.raises(ValueError, match="use (write_goal_ticks|set_torque)"):
@@ -205,7 +205,7 @@ def test_goal_and_torque_registers_cannot_be_written_as_settings(address, length
 
 
 def test_the_limit_guard_passes_settings_on():
-    port = MockPort("dynamixel", 2.0, {1: XM})
+    port = DryRunPort("dynamixel", 2.0, {1: XM})
     bus = LimitGuard(DynamixelBus("mock", 1_000_000, 2.0, {1: XM}, port_handler=port), {1: (1000, 3000)})
     bus.open()
     bus.write_register([1], 84, 2, 4978)

@@ -1,4 +1,4 @@
-"""walk_session on the real bus classes and packet code, over the bus room's MockPort.
+"""walk_session on the real bus classes and packet code, over the bus room's DryRunPort.
 
 The stream tests with a fake bus check the logic; these check it with the bytes a real run
 sends: the emulated servos end where the session says it left them, and a recording made
@@ -13,7 +13,7 @@ import pytest
 pytest.importorskip("dynamixel_sdk")
 
 from gaitbot.bus.factory import make_bus  # noqa: E402
-from gaitbot.bus.log import BusRecorder, decode_goal_frames  # noqa: E402
+from gaitbot.bus.recording import BusRecorder, decode_goal_frames  # noqa: E402
 from gaitbot.stream.clock import VirtualClock  # noqa: E402
 from gaitbot.servos.models import servo_model  # noqa: E402
 from gaitbot.stream import walk_session  # noqa: E402
@@ -31,7 +31,7 @@ def walk_frames(count: int = 90) -> np.ndarray:
 
 def mock_bus(tmp_path, recorder=None):
     models = {i: servo_model("XL430-W250") for i in IDS}
-    return make_bus("dynamixel", 2.0, "mock", 1_000_000, models, dry_run=True, recorder=recorder)
+    return make_bus("dynamixel", 2.0, "mock", 1_000_000, models, interface="dry-run", recorder=recorder)
 
 
 def test_completed_walk_on_the_mock_bus_leaves_servos_standing(tmp_path):

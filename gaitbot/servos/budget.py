@@ -1,5 +1,8 @@
 """How much of a frame period the serial bus needs, so a rate that cannot fit is refused up front.
 
+Vendor facts only (baud rates, packet sizes): the robot room checks every config against it on load
+(gaitbot.robot.config.check_bus_rate), so loading a robot runs no bus code.
+
 Counts the bytes of one frame (the goal sync write, plus the read-back when asked) from the
 packet layouts in the ROBOTIS e-Manual and the Feetech protocol manual, at 10 bits per byte
 (start + 8 data + stop, no parity), plus each servo's return delay before its status packet.
@@ -11,7 +14,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from gaitbot.robot.config import ConfigError, RobotConfig
 from gaitbot.servos import ASSUMED_RETURN_DELAY_S, BACKENDS, has_sync_read, wire
 from gaitbot.servos.health import health_block
 from gaitbot.servos.models import ServoModel, servo_model
@@ -100,18 +102,3 @@ def check_rate(rate_hz: float, backend: str, protocol: float, model: ServoModel 
             f"({budget.bytes_per_frame} bytes) of a {period_s * 1e3:.1f} ms period, more than {margin:.0%}; "
             f"at most {margin / budget.wire_time_s:.1f} Hz, or raise the baud rate")
     return budget
-
-
-def check_robot_rate(config: RobotConfig, rate_hz: float) -> FrameBudget:
-    """check_rate for a robot config's bus and servos, with the read-back every session makes."""
-    return check_rate(rate_hz, config.bus.backend, config.bus.protocol, config.joints[0].model, len(config.joints),
-                      config.bus.baudrate, read_back=True)
-
-
-def bus_budget_check(config: RobotConfig) -> None:
-    """A config check (``load_robot_config(extra_checks=...)``): refuse a ``gait.rate_hz`` the bus cannot
-    carry (writes plus a read-back) with margin."""
-    try:
-        check_robot_rate(config, config.gait.rate_hz)
-    except ValueError as exc:
-        raise ConfigError(config.path, "gait.rate_hz", str(exc)) from None

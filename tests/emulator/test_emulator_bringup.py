@@ -11,7 +11,8 @@ import math
 
 import pytest
 
-from gaitbot.bus import emulator as se
+import gaitbot.emulator as se
+from gaitbot.emulator.units import ACCESS_ERROR
 from gaitbot.servos import wire
 from gaitbot.servos.models import servo_model
 
@@ -90,7 +91,7 @@ def test_a_protocol2_servo_refuses_an_eeprom_write_with_torque_on():
     chain = fresh("dynamixel", 2.0, XL430)
     ask(chain, build("v2", 1, wire.INST_WRITE, addr("v2", 64, 1)), 1.0)  # torque on
     (reply,) = ask(chain, build("v2", 1, wire.INST_WRITE, addr("v2", 7, 9)), 1.1)
-    assert reply.error == se.ACCESS_ERROR
+    assert reply.error == ACCESS_ERROR
     assert chain.units[0].servo_id == 1 and chain.writes[-1][-1] is False
 
 

@@ -14,9 +14,9 @@ import time
 import pytest
 
 from gaitbot.servos import wire
-from gaitbot.bus.log import decode_goal_frames
+from gaitbot.bus.recording import decode_goal_frames
 from gaitbot.servos.models import servo_model
-from gaitbot.bus import emulator as se
+import gaitbot.emulator as se
 from gaitbot.app import emulator as emulator_cli
 from helpers import REPO_ROOT
 

@@ -2,7 +2,7 @@
 
 import pytest
 
-from gaitbot.bus.budget import check_rate, frame_budget, max_rate_hz
+from gaitbot.servos.budget import check_rate, frame_budget, max_rate_hz
 from gaitbot.servos.models import SERVO_MODELS
 
 X = SERVO_MODELS["XL430-W250"]

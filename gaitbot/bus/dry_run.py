@@ -1,11 +1,12 @@
-"""A serial port with a healthy servo chain behind it, for dry runs and tests.
+"""The dry-run port: a serial port with a healthy servo chain behind it (``gaitbot walk --dry-run``, tests).
 
-MockPort stands where the SDK's PortHandler stands (the httpx MockTransport idea): the real
-DynamixelBus / FeetechBus and the real SDK packet code run on top of it, so a dry run produces
-byte for byte what a real run would send. It parses each instruction packet with gaitbot.servos.wire
-(written from the protocol documents, not from the SDK) and answers as the servos would:
+DryRunPort stands where the SDK's PortHandler stands (the httpx MockTransport idea, python-can's virtual
+bus): the factory picks it by name (``interface="dry-run"``), and the real DynamixelBus / FeetechBus and
+the real SDK packet code run on top of it, so a dry run produces byte for byte what a real run would
+send. It reads each instruction packet with gaitbot.bus.packets (on gaitbot.servos.wire, written from
+the protocol documents, not from the SDK) and answers as the servos would:
 
-* ping: status packet (Dynamixel 2.0 adds model number and firmware version);
+* ping: status packet (Dynamixel 2.0 adds the Model Number register and firmware version);
 * write: stored in the servo's control table, status packet unless broadcast (the table starts with
   the vendor table's factory values, the servo's id, the Baud Rate register of the bus's rate, the
   model number and the centre tick as goal and present position);
@@ -24,6 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from gaitbot.bus.packets import take_packets
 from gaitbot.servos import baud_rates, baud_register_value, vendor, wire
 from gaitbot.servos.models import ServoModel
 
@@ -33,7 +35,7 @@ BAUD_TOLERANCE = 0.03
 _TABLE_SIZE_BYTES = 1024
 
 
-class MockPort:
+class DryRunPort:
     """Duck-typed PortHandler for dynamixel_sdk and scservo_sdk with emulated servos behind it.
 
     tx_packets / rx_packets keep every packet written by the host / answered by the chain, as bytes.
@@ -86,8 +88,8 @@ class MockPort:
         self.port_name = port_name
 
     def clearPort(self) -> None:  # noqa: N802
-        """Behave like the SDK being mocked: dynamixel_sdk drops input, scservo_sdk only flushes output."""
-        if self.backend == "dynamixel":
+        """Behave like the SDK under it: dynamixel_sdk drops input, scservo_sdk only flushes output."""
+        if self.vendor.SDK_CLEAR_PORT_DROPS_INPUT:
             self._rx_buffer.clear()
 
     def reset_input_buffer(self) -> None:
@@ -104,12 +106,12 @@ class MockPort:
     def writePort(self, packet) -> int:  # noqa: N802
         data = bytes(packet)
         self._tx_buffer += data
-        for raw, is_packet in wire.split_complete(self._tx_buffer, self.framing):
-            if not is_packet:
+        for raw, frame in take_packets(self._tx_buffer, self.framing, status=False):
+            if frame is None:
                 self.rejected.append((raw, "bytes outside any packet"))
                 continue
             self.tx_packets.append(raw)
-            self._answer(raw)
+            self._answer(raw, frame)
         return len(data)
 
     def setPacketTimeout(self, packet_length) -> None:  # noqa: N802
@@ -173,8 +175,7 @@ class MockPort:
             return True
         return rates_match(self.servo_rate(self.models[servo_id], self.tables[servo_id]), self.baudrate)
 
-    def _answer(self, raw: bytes) -> None:
-        frame = wire.parse(raw, self.framing, status=False)
+    def _answer(self, raw: bytes, frame: wire.Frame) -> None:
         if not frame.checksum_ok:
             self.rejected.append((raw, frame.problem))  # a servo ignores a damaged packet
             return
@@ -197,9 +198,9 @@ class MockPort:
         for servo_id in self._targets(frame.packet_id):
             extra = b""
             if self.framing == "v2":  # Protocol 2.0 ping: model number (2 bytes) and firmware version
-                model = self.models[servo_id]
-                firmware = self.tables[servo_id][model.control_table["Firmware Version"].address]
-                extra = bytes([model.model_number & 0xFF, model.model_number >> 8, firmware])
+                table, registers = self.tables[servo_id], self.models[servo_id].control_table
+                number = registers["Model Number"].address
+                extra = bytes(table[number:number + 2]) + bytes([table[registers["Firmware Version"].address]])
             self._reply(servo_id, extra)
 
     def _read(self, frame: wire.Frame) -> None:
