@@ -20,8 +20,8 @@ import signal
 import numpy as np
 import pytest
 
-from gaitbot.bus import mock
-from gaitbot.bus.log import decode_goal_frames
+from gaitbot.bus import dry_run as mock
+from gaitbot.bus.recording import decode_goal_frames
 from gaitbot.robot.calibration import standing_ticks, tick_limits
 from helpers import config, run_cli
 
@@ -57,7 +57,7 @@ class Chain:
 def chain_patch(monkeypatch):
     """Install a Chain's behaviour on the mock port class; give back a function that sets the Chain."""
     state = {}
-    initial_table, write_port, reply = mock.MockPort.initial_table, mock.MockPort.writePort, mock.MockPort._reply
+    initial_table, write_port, reply = mock.DryRunPort.initial_table, mock.DryRunPort.writePort, mock.DryRunPort._reply
 
     def shifted_table(model, servo_id, baudrate=None):
         table = initial_table(model, servo_id, baudrate)
@@ -96,9 +96,9 @@ def chain_patch(monkeypatch):
             return
         reply(self, servo_id, params)
 
-    monkeypatch.setattr(mock.MockPort, "initial_table", staticmethod(shifted_table))
-    monkeypatch.setattr(mock.MockPort, "writePort", writing)
-    monkeypatch.setattr(mock.MockPort, "_reply", replying)
+    monkeypatch.setattr(mock.DryRunPort, "initial_table", staticmethod(shifted_table))
+    monkeypatch.setattr(mock.DryRunPort, "writePort", writing)
+    monkeypatch.setattr(mock.DryRunPort, "_reply", replying)
     old = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
     yield lambda chain: state.__setitem__("chain", chain)
     for signum, handler in old.items():  # gaitbot ignores signals once a signalled command ends
