@@ -147,8 +147,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the robot walks on a boom: accept a walk that would tip a free-standing robot (with --sim: "
                    "the simulated torso rides a boom, sliding forward and up, pitch held)")
     p.add_argument("--free-pitch", action="store_true", help="--sim: the boom, with the torso free to pitch on it")
-    p.add_argument("--push", type=float, metavar="N_S", help="--sim: push the torso sideways with this impulse "
-                   "(N s, positive to the left) in the middle of a step half-way through the walk")
+    from gaitbot.app.sim_options import add_sim_model_options  # light: argparse and the options module
+
+    add_sim_model_options(p)
     p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (three-quarter view)")
     p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
 

@@ -12,6 +12,7 @@ import sys
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
 from gaitbot.app.progress import callback, progress
+from gaitbot.app.sim_options import check_sim_model, foreign_model, parse_push
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.log import BusRecorder, RecordingFailed
@@ -80,7 +81,9 @@ def run(args) -> int:
         from gaitbot.sim.walk import SimWalk, walk_plan  # MuJoCo: only with --sim
 
         sim = SimWalk(config, source.settings.rate_hz, walk_plan(walker, planned), sim_support(args, config),
-                      args.video, args.push)
+                      args.video, args.push, args.push_direction_deg, foreign_model(args))
+        for note in getattr(sim.robot, "notes", ()):
+            print(f"note: --sim-model: {note}", file=sys.stderr)
     hardware = not (args.dry_run or args.sim)
     port = serial_port(config, args.port, dry_run=not hardware)
     clock = MonotonicClock() if (hardware or args.realtime) else VirtualClock()
@@ -174,15 +177,11 @@ def sim_support(args, config) -> str:
     return "boom" if (args.boom or config.boom) else "free"
 
 
-MAX_PUSH_NS = 20.0
-"""The largest --push (N s): far beyond what knocks over any small humanoid (docs/simulation.md)."""
-
-
 def check_sim_arguments(args) -> None:
     """Refuse what a simulated walk cannot honour, and a missing MuJoCo, before any work is done."""
     sim = getattr(args, "sim", False)
     if not sim:
-        for flag in ("free_pitch", "push", "video", "json"):
+        for flag in ("free_pitch", "push", "video", "json", "sim_model", "sim_map"):
             if getattr(args, flag, None):
                 raise UsageError(f"--{flag.replace('_', '-')}: only with --sim (a simulated walk)")
         return
@@ -197,13 +196,10 @@ def check_sim_arguments(args) -> None:
     for flag, why in refused.items():
         if getattr(args, flag, None):
             raise UsageError(f"--{flag.replace('_', '-')}: {why}")
-    push = getattr(args, "push", None)
-    if push is not None:
-        if not (math.isfinite(push) and push != 0 and abs(push) <= MAX_PUSH_NS):
-            raise UsageError(f"--push must be a non-zero impulse of at most {MAX_PUSH_NS:g} N s (positive to the left), "
-                             f"got {push!r}")
-        if getattr(args, "boom", False) or getattr(args, "free_pitch", False):
-            raise UsageError("--push: a sideways push needs a free-floating torso (the boom holds it sideways)")
+    args.push, args.push_direction_deg = parse_push(getattr(args, "push", None))
+    if args.push is not None and (getattr(args, "boom", False) or getattr(args, "free_pitch", False)):
+        raise UsageError("--push: a sideways push needs a free-floating torso (the boom holds it sideways)")
+    check_sim_model(args)
     import_mujoco()
     if getattr(args, "video", None):
         check_video_path(args.video)
