@@ -150,6 +150,9 @@ def build_parser() -> argparse.ArgumentParser:
     from gaitbot.app.sim_options import add_sim_model_options  # light: argparse and the options module
 
     add_sim_model_options(p)
+    from gaitbot.app.feel_options import add_feedback_option
+
+    add_feedback_option(p)
     p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (three-quarter view)")
     p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
 

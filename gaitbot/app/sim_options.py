@@ -19,6 +19,10 @@ def add_sim_model_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--push", metavar="N_S[@DEG]", help="--sim: push the torso with this impulse (N s) in the middle "
                    "of a step half-way through the walk; @DEG: its direction in degrees from forward, counter-clockwise "
                    "(default 90: to the left; a negative impulse pushes the opposite way)")
+    p.add_argument("--imu-fault", choices=("frozen", "noisy", "absent"), help="--sim: break the simulated IMU 1 s "
+                   "into the walk (docs/feedback.md says what the walk does then)")
+    p.add_argument("--imu-seed", type=int, default=0, metavar="N", help="--sim: seed of the simulated IMU's noise "
+                   "and bias (default 0)")
     p.add_argument("--sim-model", metavar="FILE.xml", help="--sim: walk another author's MuJoCo model of the robot "
                    "(its own servos, floor and inertias) instead of the one built from the config; needs --sim-map")
     p.add_argument("--sim-map", metavar="MAP.toml", help="--sim-model: which model joint is which gaitbot joint "

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import sys
 
+from gaitbot.app.feel_options import fall_dict, fall_line, feedback_mode, make_feedback
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
 from gaitbot.app.progress import callback, progress
@@ -81,7 +82,8 @@ def run(args) -> int:
         from gaitbot.sim.walk import SimWalk, walk_plan  # MuJoCo: only with --sim
 
         sim = SimWalk(config, source.settings.rate_hz, walk_plan(walker, planned), sim_support(args, config),
-                      args.video, args.push, args.push_direction_deg, foreign_model(args))
+                      args.video, args.push, args.push_direction_deg, foreign_model(args), args.imu_seed,
+                      args.imu_fault)
         for note in getattr(sim.robot, "notes", ()):
             print(f"note: --sim-model: {note}", file=sys.stderr)
     hardware = not (args.dry_run or args.sim)
@@ -115,6 +117,7 @@ def run(args) -> int:
     for note in gain_notes(config):
         print(f"note: {note}", file=sys.stderr)
     health = HealthMonitor.for_robot(config, _warn_line, clock.now)
+    feedback = make_feedback(config, feedback_mode(args, config), bus, clock, period)
     what = "simulating" if sim is not None else "walking"
     try:
         with progress(what, total=len(frames), unit="frame") as bar:
@@ -122,12 +125,15 @@ def run(args) -> int:
                                   max_accel_ticks_per_s2=acceleration, period_s=period, clock=clock,
                                   torque_off_on_exit=config.bus.torque_off_on_exit,
                                   on_frame=_status(bar, walker.heel_strikes, source.settings.rate_hz, health),
-                                  setup_writes=gain_writes(config), health=health)
+                                  setup_writes=gain_writes(config), health=health, feedback=feedback)
     finally:
         if recorder is not None:
             recorder.close()
     for note in getattr(bus, "open_notes", []):
         print(f"note: {note}", file=sys.stderr)
+    if sim is not None:
+        sim.extra["feedback"] = feedback.mode if feedback is not None else "none"
+        sim.extra["fall_noticed"] = fall_dict(result, sim.tilt_crossed_s(config.imu.fall_tilt_deg))
     if sim is not None and args.json:
         return _sim_exit(_sim_report(sim, True, result.outcome, args.video), result.exit_code)
     if sim is not None:
@@ -147,6 +153,8 @@ def run(args) -> int:
           f"{trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.3f} m planned. {result.message()}")
     if result.walk_stats is not None:
         print(result.walk_stats.summary(simulated_clock=isinstance(clock, VirtualClock)))
+    if fall_line(result, feedback):
+        print(fall_line(result, feedback))
     if health.summary():
         print(health.summary())
     if args.record:
@@ -181,7 +189,7 @@ def check_sim_arguments(args) -> None:
     """Refuse what a simulated walk cannot honour, and a missing MuJoCo, before any work is done."""
     sim = getattr(args, "sim", False)
     if not sim:
-        for flag in ("free_pitch", "push", "video", "json", "sim_model", "sim_map"):
+        for flag in ("free_pitch", "push", "video", "json", "sim_model", "sim_map", "imu_fault"):
             if getattr(args, flag, None):
                 raise UsageError(f"--{flag.replace('_', '-')}: only with --sim (a simulated walk)")
         return

@@ -140,6 +140,12 @@ class Bus(ABC):
             return ReadBack(servo_id, "missed")
         return ReadBack(servo_id, "answered" if ticks is not None else "missed", ticks)
 
+    def read_device(self, device_id: int, address: int, length: int, budget_s: float) -> bytes | None:
+        """One READ of a device on the bus that is not a servo (the OP3's OpenCR IMU) within ``budget_s``,
+        never retried, never waited on beyond it: its bytes, or None when it did not answer in time (or said
+        an error). Buses that talk to no device have none: None."""
+        return None
+
     def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
         """Write a setting (a gain, a lock flag) to each servo, waiting for each one's status packet.
 

@@ -60,6 +60,9 @@ class LimitGuard(Bus):
     def set_read_back_blocks(self, blocks: dict[int, tuple[int, int]]) -> None:
         self.inner.set_read_back_blocks(blocks)
 
+    def read_device(self, device_id: int, address: int, length: int, budget_s: float) -> bytes | None:
+        return self.inner.read_device(device_id, address, length, budget_s)
+
     def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
         """Settings are not goals: passed on (the backend refuses a write to the goal or torque register)."""
         self.inner.write_register(ids, address, length, value)

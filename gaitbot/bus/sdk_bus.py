@@ -396,6 +396,17 @@ class SdkBus(Bus):
         ticks = self._decode(data[offset:offset + self._present[1]], self._model(servo_id))
         return ReadBack(servo_id, "answered", ticks, data, error, late_s)
 
+    def read_device(self, device_id: int, address: int, length: int, budget_s: float) -> bytes | None:
+        """One budgeted READ of a non-servo device (Bus.read_device): the read-back's exchange, without its
+        bookkeeping of late replies (a reply that comes after its budget is dropped as stale input)."""
+        self._require_open()
+        if not budget_s >= MIN_READ_BACK_BUDGET_S:
+            return None
+        outcome, frame = self._budgeted_read(device_id, address, length, budget_s, time.monotonic())
+        if frame is None or frame.error or len(frame.params) != length:
+            return None
+        return bytes(frame.params)
+
     def _budgeted_read(self, servo_id: int, address: int, length: int, budget_s: float,
                        start_s: float) -> tuple[str, wire.Frame | None]:
         """Send READ(address, length) to ``servo_id`` through the SDK and wait for its status packet until

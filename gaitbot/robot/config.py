@@ -37,6 +37,7 @@ from gaitbot.gait.walker import WalkSettings, make_context
 from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
 from gaitbot.robot.gains import GainError, gain_for_error
 from gaitbot.robot.health import HealthSettings, read_health
+from gaitbot.robot.imu_settings import ImuSettings, read_imu
 from gaitbot.servos import BACKENDS, dynamixel, feetech, max_servo_id, vendor
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
 
@@ -183,6 +184,7 @@ class RobotConfig:
     balance: BalanceSettings = BalanceSettings()
     links: tuple[tuple[str, LinkInertial], ...] | None = None
     boom: bool = False
+    imu: ImuSettings = ImuSettings()  # [imu], [feedback], [fall] (gaitbot.robot.imu_settings)
 
     @cached_property
     def body(self) -> BodyModel:
@@ -337,7 +339,8 @@ TORSO_HEIGHT_LEGS = 0.6
 MASS_TOLERANCE_KG = 1e-4
 """``[mass] total_kg`` must equal the links' sum within this (0.1 g: the files hold 6 digits)."""
 
-_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain", "health", "balance", "links")
+_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain", "health", "balance", "links",
+             "imu", "feedback", "fall")
 _MASS_KEYS = ("torso_kg", "thigh_kg", "shank_kg", "foot_kg", "total_kg")
 _LINK_NAMES = ("torso",) + LEG_LINKS
 _LINK_KEYS = ("mass_kg", "com_m", "inertia_kg_m2")
@@ -383,7 +386,7 @@ class _Reader(Fields):
         balance = self.balance(self.optional_table(data, "balance", "balance", BalanceSettings.field_names()))
         config = RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
                              mass=mass, servo=servo, terrain=terrain, health=health, balance=balance, links=links,
-                             boom=boom)
+                             boom=boom, imu=read_imu(self, data, bus))
         self.three_d_checks(config)
         return config
 

@@ -70,6 +70,7 @@ class SimRobot:
         self.ankle_in_foot_m = np.zeros((len(SIDES), 3))  # the ankle point in each foot body (its origin here)
         self.foot_axes = np.array([np.eye(3)] * len(SIDES))  # gaitbot's foot axes in each foot body
         self.torso_body = model.body("torso").id
+        self.imu_body = self.torso_body  # the body the simulated IMU reads (gaitbot.sim.imu)
         self._touch_adr = np.array([model.sensor(f"touch_{side}").adr[0] for side in SIDES])
         if list(self.actuator_index) != list(range(model.nu)) or list(self._touch_adr) != list(range(model.nsensordata)):
             raise RuntimeError("the model's actuators and sensors must be in joint and side order")  # build_mjcf's

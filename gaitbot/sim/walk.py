@@ -115,12 +115,14 @@ class SimWalk:
 
     def __init__(self, config: RobotConfig, rate_hz: float, plan: WalkPlan, support: str = "free",
                  video: str | None = None, push_n_s: float | None = None, push_direction_deg: float = 90.0,
-                 foreign: tuple | None = None) -> None:
+                 foreign: tuple | None = None, imu_seed: int = 0, imu_fault: str | None = None) -> None:
         """``foreign``: (model file, SimMap) of another author's model (gaitbot.sim.foreign), else gaitbot's own."""
         from gaitbot.sim.physics import SimRobot
 
         self.config = config
         self.plan = plan
+        self.imu_seed, self.imu_fault = imu_seed, imu_fault
+        self.extra: dict = {}  # more for the JSON object (the feedback mode, the fall the IMU noticed)
         if foreign is not None:
             from gaitbot.sim.foreign import ForeignRobot
 
@@ -148,7 +150,15 @@ class SimWalk:
         """The robot's bus on the simulated chain, its physics following ``now()`` (the session's clock)."""
         from gaitbot.sim.port import make_sim_bus
 
-        return make_sim_bus(self.config, self.robot, now, recorder)
+        return make_sim_bus(self.config, self.robot, now, recorder, self.imu_seed, self.imu_fault)
+
+    def tilt_crossed_s(self, threshold_deg: float) -> float | None:
+        """When the torso's true tilt (hypot of roll and pitch, the IMU estimate's measure) first passed
+        ``threshold_deg`` (frame ends), or None: the yardstick of how soon a fall is noticed."""
+        for t_s, rpy in zip(self.meter.times_s, self.meter.rpy_deg):
+            if math.hypot(rpy[0], rpy[1]) > threshold_deg:
+                return float(t_s)
+        return None
 
     def report(self) -> SimReport:
         return self.meter.report(self.plan, self.robot.free_pitch,
@@ -160,7 +170,7 @@ class SimWalk:
         report = self.report()
         frames = self.video.save(on_progress) if self.video is not None else 0
         if as_json:
-            print(json.dumps({"robot": self.config.name, "outcome": outcome, **report.to_dict(),
+            print(json.dumps({"robot": self.config.name, "outcome": outcome, **report.to_dict(), **self.extra,
                               "video": str(self.video.path) if self.video is not None else None}, indent=2))
         else:
             print(report.summary())

@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike
 
 from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite
 from gaitbot.bus.log import RecordingFailed
+from gaitbot.feel.feedback import RobotFell
 from gaitbot.stream.clock import Clock, MonotonicClock
 from gaitbot.stream.health import HealthMonitor, ServoHealthStop
 from gaitbot.stream.pacing import StreamStats, Streamer, as_tick_frames
@@ -24,7 +25,7 @@ from gaitbot.stream.readback import ReadBackMonitor
 from gaitbot.stream.signals import Terminated, install_sigterm_handler, restore_sigterm_handler
 
 #: Exit codes by outcome, the shell's conventions (128 + SIGINT, 128 + SIGTERM).
-EXIT_CODES = {"completed": 0, "interrupted": 130, "terminated": 143, "bus_error": 1, "health_stop": 1}
+EXIT_CODES = {"completed": 0, "interrupted": 130, "terminated": 143, "bus_error": 1, "health_stop": 1, "fell": 1}
 
 
 # --------------------------------------------------------------------------- before walking
@@ -102,7 +103,7 @@ class SessionResult:
     def message(self) -> str:
         head = {"completed": "Walk completed", "interrupted": "Walk interrupted (Ctrl-C)",
                 "terminated": "Walk terminated (SIGTERM)", "bus_error": "Walk stopped by a bus error",
-                "health_stop": "Walk stopped to protect a servo"}
+                "health_stop": "Walk stopped to protect a servo", "fell": "Walk stopped: the robot fell"}
         parts = [head.get(self.outcome, self.outcome)]
         if isinstance(self.error, RecordingFailed):
             parts = ["Walk stopped because the recording failed (the serial port is fine)"]
@@ -118,7 +119,8 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
                  torque_off_on_exit: bool = False,
                  on_frame: Callable[[int, StreamStats], None] | None = None,
                  handle_sigterm: bool = True, monitor_servos: bool = True,
-                 setup_writes: Sequence[RegisterWrite] = (), health: HealthMonitor | None = None) -> SessionResult:
+                 setup_writes: Sequence[RegisterWrite] = (), health: HealthMonitor | None = None,
+                 feedback=None) -> SessionResult:
     """Open, check, ramp to the first pose, walk, and leave the robot in a known pose.
 
     Sequence: ``bus.open()`` -> :func:`prepare` (ping all, read present) -> ``setup_writes`` (the
@@ -156,6 +158,10 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
         return stop_ticks(previous_ticks, last_ticks, stand, max_velocity_ticks_per_s, max_accel_ticks_per_s2,
                           period_s)
 
+    def stop_to(previous_ticks: np.ndarray, last_ticks: np.ndarray, target: np.ndarray) -> np.ndarray:
+        return stop_ticks(previous_ticks, last_ticks, target, max_velocity_ticks_per_s, max_accel_ticks_per_s2,
+                          period_s)
+
     read_back = None
     if monitor_servos:
         on_answer = None
@@ -164,8 +170,11 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             on_answer = health.observe_read_back
         read_back = ReadBackMonitor(bus, ids, clock, period_s, on_answer=on_answer)
 
-    def streamer(callback=None, monitored: bool = False) -> Streamer:
-        return Streamer(bus, ids, period_s, clock, callback, monitor=read_back if monitored else None)
+    def streamer(callback=None, monitored: bool = False, felt: bool = False) -> Streamer:
+        monitor = read_back if monitored else None
+        if felt and feedback is not None:  # the IMU read after the read-back, in the same frame's budget
+            monitor = _both(monitor, feedback.sense)
+        return Streamer(bus, ids, period_s, clock, callback, monitor=monitor, feedback=feedback if felt else None)
 
     old_handler = install_sigterm_handler() if handle_sigterm else None
     state = _SessionState()
@@ -189,12 +198,16 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             state.next_deadline_s = first_sent_s + period_s
             if not at_start:
                 state.run(streamer(monitored=True), ramp(present, walk[0]))
-            state.run(streamer(on_frame, monitored=True), walk[1:] if at_start else walk, is_walk=True)
+            state.run(streamer(on_frame, monitored=True, felt=True), walk[1:] if at_start else walk, is_walk=True)
             state.run(streamer(monitored=True), stop(walk[-2] if len(walk) > 1 else walk[-1], walk[-1]))
             outcome, error = "completed", None
         except (KeyboardInterrupt, Terminated) as exc:
             outcome, error = ("terminated" if isinstance(exc, Terminated) else "interrupted"), None
             state.safe_stop(streamer, stop)
+        except RobotFell as exc:  # stop stepping, lower the CoM, then the config's response (gaitbot.feel)
+            outcome, error = "fell", exc
+            state.fall_stop(streamer, stop_to, feedback)
+            torque_off_on_exit = torque_off_on_exit or feedback.settings.fall_response == "torque_off"
         except ServoHealthStop as exc:  # a servo too hot or under-powered: the safe stop of a bus fault
             outcome, error = "health_stop", exc
             state.safe_stop(streamer, stop)
@@ -273,6 +286,19 @@ class _SessionState:
         except BusError as exc:
             self.notes.append(f"stop ramp abandoned: {exc}")
 
+    def fall_stop(self, streamer: Callable[[], Streamer], stop_to, feedback) -> None:
+        """A fall: brake from the motion under way into the fall pose (the legs folded: the CoM lower)."""
+        if not self.torque_on or self.last_sent is None:
+            return
+        previous = self.previous_sent if self.previous_sent is not None else self.last_sent
+        try:
+            self.run(streamer(), stop_to(previous, self.last_sent, feedback.fall_pose(self.last_sent)))
+            self.notes.append(f"{feedback.settings.fall_response.replace('_', ' ')} after lowering the CoM")
+        except (KeyboardInterrupt, Terminated):
+            self.notes.append("fall stop abandoned on a second interrupt")
+        except BusError as exc:
+            self.notes.append(f"fall stop abandoned: {exc}")
+
     def finish(self, bus: Bus, ids: list[int], torque_off_on_exit: bool) -> None:
         if not (torque_off_on_exit and self.torque_on) or self.port_lost:
             return
@@ -299,3 +325,14 @@ class _SessionState:
             self.notes.append("closing the bus was interrupted")
         except Exception as exc:  # noqa: BLE001 - reported to the caller in the notes
             self.notes.append(f"closing the bus failed: {exc}")
+
+
+def _both(first: Callable[[float], None] | None, second: Callable[[float], None]) -> Callable[[float], None]:
+    """Two per-frame monitors, one after the other (the read-back, then the IMU read)."""
+    if first is None:
+        return second
+
+    def both(deadline_s: float) -> None:
+        first(deadline_s)
+        second(deadline_s)
+    return both
