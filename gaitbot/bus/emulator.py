@@ -208,6 +208,7 @@ class EmulatorConfig:
     temperatures_c: dict[int, float] = field(default_factory=dict)  # servo id -> temperature at the start
     supply_v: float | None = None  # None: the first servo's usual supply (its Present Voltage factory value)
     voltage_sag_v_per_s: float = 0.0  # the supply falls this fast once faults are active
+    imu: object | None = None  # an IMU device on the line (gaitbot.bus.imu_device.ImuDevice), answering at its id
 
 
 class EmulatedChain(MockPort):
@@ -497,6 +498,9 @@ class EmulatedChain(MockPort):
             return
         if self.framing == "v2" and frame.instruction == wire.INST_STATUS_V2:
             return  # a status packet on the line is not for us
+        if self.config.imu is not None and frame.packet_id == self.config.imu.device_id:
+            self._imu_answer(frame)
+            return
         self._instruction = frame.instruction
         self._instruction_rate = self.line_baud
         first_reply = len(self.outbox)
@@ -507,6 +511,16 @@ class EmulatedChain(MockPort):
         self._use(self._primary)
         self._collide(first_reply, frame)
         self._log_goals(raw, frame)
+
+    def _imu_answer(self, frame: wire.Frame) -> None:
+        """The IMU device's status packet, on the line after what is already on it (its Return Delay Time is 0)."""
+        packet = self.config.imu.answer(frame, self.now_s)
+        if packet is None:
+            return
+        send_s = max(self.now_s, self._busy_until_s)
+        self._busy_until_s = send_s + len(packet) * 10 / (self.line_baud or self.baudrate)
+        self.rx_packets.append(packet)
+        self.outbox.append((send_s, packet, self.line_baud))
 
     def _handle(self, frame: wire.Frame, raw: bytes) -> None:
         extra = {INST_REG_WRITE: self._reg_write, INST_ACTION: self._action, INST_REBOOT: self._reboot}
