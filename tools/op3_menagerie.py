@@ -11,22 +11,29 @@ meshes are left out (visual and collision): only its two box feet per foot touch
 come from its explicit inertials, which is what matters for the dynamics. The numbers below are its
 facts, rewritten as a table; ``menagerie_mjcf`` assembles the document.
 
-Mapping: Menagerie's joint angles are ROBOTIS's (same axes and zero pose), so ours = direction x theirs
-with the directions of config/op3.toml (its ROBOTIS-to-ours signs). The arms and head are held at
-ROBOTIS's initial pose (op3_base_module/data/ini_pose.yaml), as config/op3.toml's torso assumes.
-Used by tools/robustness.py (and so by tests/sim/test_sim_balance.py's quick robustness run).
+Mapping: config/sim-maps/op3-menagerie.toml (the --sim-map of ``gaitbot walk --sim --sim-model``): ours =
+sign x theirs, the arms and head held at ROBOTIS's initial pose. ``python tools/op3_menagerie.py FILE.xml``
+writes the model for ``--sim-model``. ``play`` is the open-loop player of tools/robustness.py (and so of
+tests/sim/test_sim_balance.py's quick robustness run); ``gaitbot walk --sim --sim-model`` walks the same
+model through the whole session instead (gaitbot.sim.foreign).
 
     python tools/op3_menagerie.py > op3.xml           # the stripped model (docs/robot-description.md imports it)
+    python tools/op3_menagerie.py op3-menagerie.xml   # the same, written to a file (for --sim-model)
     python tools/op3_menagerie.py --play walk.npz     # a trajectory played open loop on it (exit 1: a fall,
                                                       # or travelled more than PLAN_SHARE off the plan)
 """
 
 from __future__ import annotations
 
+import argparse
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+
+from gaitbot.gait.joints import LEG_JOINTS
+from gaitbot.sim.sim_map import hold_rad, load_sim_map
 
 # body: (parent, pos, (quat, mass, diaginertia, ipos), joint name, joint axis)
 _BODIES = (
@@ -82,16 +89,10 @@ def _leg(side: str) -> tuple:
 _FEET = (((0.024, 0.013, -0.0265), (0.0635, 0.028, 0.004)), ((0.024, 0.0125, -0.0265), (0.057, 0.039, 0.004)))
 """Menagerie's two box feet per foot (position in the ank_roll link, half sizes; massless)."""
 
-JOINT_MAP = {  # our leg joint -> (Menagerie's joint suffix, ours = sign x theirs per side: config/op3.toml)
-    "hip_yaw": ("hip_yaw", {"left": -1, "right": 1}),
-    "hip_roll": ("hip_roll", {"left": -1, "right": 1}),
-    "hip_pitch": ("hip_pitch", {"left": -1, "right": 1}),
-    "knee_pitch": ("knee", {"left": 1, "right": -1}),
-    "ankle_pitch": ("ank_pitch", {"left": 1, "right": -1}),
-    "ankle_roll": ("ank_roll", {"left": 1, "right": -1}),
-}
-ARM_HOLD_RAD = {"head_pan": 0.0, "head_tilt": -0.17453, "l_sho_pitch": -0.2618, "r_sho_pitch": 0.2618,
-                "l_sho_roll": 0.7854, "r_sho_roll": -0.7854, "l_el": -0.7854, "r_el": 0.7854}
+MAP_PATH = Path(__file__).resolve().parents[1] / "config" / "sim-maps" / "op3-menagerie.toml"
+"""Which Menagerie joint is which of ours, with its sign, and the held arms and head: the shipped --sim-map."""
+SIM_MAP = load_sim_map(MAP_PATH)
+ARM_HOLD_RAD = hold_rad(SIM_MAP)
 FALL_TILT_DEG = 45.0
 PLAN_SHARE = 0.15  # --play's pass: within 15% of the planned distance (issue 24)
 PUSH_DURATION_S = 0.1
@@ -100,9 +101,8 @@ SETTLE_AFTER_S = 1.0
 
 def their_joint(our_name: str) -> tuple[str, int]:
     """Menagerie's joint name and the sign (ours = sign x theirs) for one of our leg joints."""
-    kind, side = our_name.rsplit("_", 1)
-    theirs, signs = JOINT_MAP[kind]
-    return f"{side[0]}_{theirs}", signs[side]
+    link = SIM_MAP.joints[our_name]
+    return link.model_joint, link.sign
 
 
 def _f(*v) -> str:
@@ -179,7 +179,7 @@ def play(trajectory, rate_hz: float, friction: float = 1.0, push_n_s: float = 0.
 
     model = mujoco.MjModel.from_xml_string(menagerie_mjcf(friction))
     data = mujoco.MjData(model)
-    names = [f"{k}_{s}" for s in ("left", "right") for k in JOINT_MAP]
+    names = list(LEG_JOINTS)
     theirs = [their_joint(n) for n in names]
     actuator = {model.actuator(a).trnid[0]: a for a in range(model.nu)}
     act = np.array([actuator[model.joint(t).id] for t, _ in theirs])
@@ -240,10 +240,14 @@ def main(argv=None) -> int:
     import sys
 
     parser = argparse.ArgumentParser(description="MuJoCo Menagerie's OP3 without meshes: print it, or play a walk")
+    parser.add_argument("file", nargs="?", help="write the model to this file (default: print it)")
     parser.add_argument("--play", metavar="TRAJECTORY", help="a trajectory (gaitbot generate) to play open loop")
     args = parser.parse_args(argv)
     if args.play is None:
-        sys.stdout.write(menagerie_mjcf())
+        if args.file:
+            Path(args.file).write_text(menagerie_mjcf())
+        else:
+            sys.stdout.write(menagerie_mjcf())
         return 0
     from gaitbot.gait.trajectory import Trajectory
 

@@ -11,10 +11,12 @@ import math
 import sys
 
 from gaitbot.app.arguments import add_command, bus_options, check_walk_source, walk_options
+from gaitbot.app.feel_options import add_feedback_option, fall_dict, fall_line, feedback_mode, make_feedback
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
 from gaitbot.app.planned_walk import PlannedWalk, planned_walk
 from gaitbot.app.progress import callback, progress
+from gaitbot.app.sim_options import add_sim_model_options, check_sim_model, foreign_model, parse_push
 from gaitbot.app.view_options import add_view_options, open_view
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.recording import BusRecorder, RecordingFailed
@@ -77,8 +79,8 @@ def add_parser(subparsers):
                    help="the robot walks on a boom: accept a walk that would tip a free-standing robot (with --sim: "
                    "the simulated torso rides a boom, sliding forward and up, pitch held)")
     p.add_argument("--free-pitch", action="store_true", help="--sim: the boom, with the torso free to pitch on it")
-    p.add_argument("--push", type=float, metavar="N_S", help="--sim: push the torso sideways with this impulse "
-                   "(N s, positive to the left) in the middle of a step half-way through the walk")
+    add_sim_model_options(p)  # --push, --imu-fault, --imu-seed, --sim-model, --sim-map (gaitbot.app.sim_options)
+    add_feedback_option(p)  # --feedback (gaitbot.app.feel_options)
     p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (three-quarter view)")
     p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
     add_view_options(p)  # --mcap, --foxglove (gaitbot.app.view_options)
@@ -109,7 +111,10 @@ def run(args) -> int:
         from gaitbot.sim.walk import SimWalk, walk_plan  # MuJoCo: only with --sim
 
         sim = SimWalk(config, walk.rate_hz, walk_plan(walk.plan, walk.planned), sim_support(args, config),
-                      args.video, args.push)
+                      args.video, args.push, args.push_direction_deg, foreign_model(args), args.imu_seed,
+                      args.imu_fault)
+        for note in getattr(sim.robot, "notes", ()):
+            print(f"note: --sim-model: {note}", file=sys.stderr)
     hardware = not (args.dry_run or args.sim)
     port = serial_port(config, args.port, dry_run=not hardware)
     clock = MonotonicClock() if (hardware or args.realtime) else VirtualClock()
@@ -124,10 +129,11 @@ def run(args) -> int:
         print(f"note: {note}", file=sys.stderr)
     health = HealthMonitor.for_robot(config, _warn_line, clock.now)
     velocity, acceleration = joint_limits_ticks(config)
+    feedback = make_feedback(config, feedback_mode(args, config), bus, clock, 1.0 / walk.rate_hz)
     session = WalkSession(bus, config.ids, standing_ticks(config),
                           SessionLimits(velocity, acceleration, 1.0 / walk.rate_hz), clock=clock,
                           torque_off_on_exit=config.bus.torque_off_on_exit, setup_writes=gain_writes(config),
-                          health=health)
+                          health=health, feedback=feedback)
     view = None
     try:
         view = open_view(args, config, walk.goals, walk.planned, health, not isinstance(clock, VirtualClock))
@@ -141,7 +147,7 @@ def run(args) -> int:
             view.close()
     for note in bus.open_notes:
         print(f"note: {note}", file=sys.stderr)
-    return _report(args, config, walk, result, sim, port, clock, health)
+    return _report(args, config, walk, result, sim, port, clock, health, feedback)
 
 
 def _recorder(args, config, clock, rate_hz: float) -> BusRecorder | None:
@@ -168,10 +174,12 @@ def _open_bus(args, config, port: str, sim, clock, recorder: BusRecorder | None)
         if isinstance(exc, RecordingFailed) and isinstance(exc.__cause__, OSError):
             reason = exc.__cause__.strerror or exc.__cause__
         raise UsageError(f"--record {args.record}: cannot write the recording ({reason}); nothing was sent") from None
-
-
-def _report(args, config, walk: PlannedWalk, result, sim, port: str, clock, health: HealthMonitor) -> int:
+def _report(args, config, walk: PlannedWalk, result, sim, port: str, clock, health: HealthMonitor,
+            feedback) -> int:
     """What the walk did, on stdout (or the simulation's measurements as JSON), and the exit status."""
+    if sim is not None:
+        sim.extra["feedback"] = feedback.mode if feedback is not None else "none"
+        sim.extra["fall_noticed"] = fall_dict(result, sim.tilt_crossed_s(config.imu.fall_tilt_deg))
     if sim is not None and args.json:
         return _sim_exit(_sim_report(sim, True, result.outcome, args.video), result.exit_code)
     if sim is not None:
@@ -192,6 +200,8 @@ def _report(args, config, walk: PlannedWalk, result, sim, port: str, clock, heal
           f"{root[-1, 0] - root[0, 0]:.3f} m planned. {result.message()}")
     if result.walk_stats is not None:
         print(result.walk_stats.summary(simulated_clock=isinstance(clock, VirtualClock)))
+    if fall_line(result, feedback):
+        print(fall_line(result, feedback))
     if health.summary():
         print(health.summary())
     if args.record:
@@ -222,15 +232,11 @@ def sim_support(args, config) -> TorsoSupport:
     return TorsoSupport.BOOM if (args.boom or config.boom) else TorsoSupport.FREE
 
 
-MAX_PUSH_NS = 20.0
-"""The largest --push (N s): far beyond what knocks over any small humanoid (docs/simulation.md)."""
-
-
 def check_sim_arguments(args) -> None:
     """Refuse what a simulated walk cannot honour, and a missing MuJoCo, before any work is done."""
     sim = getattr(args, "sim", False)
     if not sim:
-        for flag in ("free_pitch", "push", "video", "json"):
+        for flag in ("free_pitch", "push", "video", "json", "sim_model", "sim_map", "imu_fault"):
             if getattr(args, flag, None):
                 raise UsageError(f"--{flag.replace('_', '-')}: only with --sim (a simulated walk)")
         return
@@ -245,13 +251,10 @@ def check_sim_arguments(args) -> None:
     for flag, why in refused.items():
         if getattr(args, flag, None):
             raise UsageError(f"--{flag.replace('_', '-')}: {why}")
-    push = getattr(args, "push", None)
-    if push is not None:
-        if not (math.isfinite(push) and push != 0 and abs(push) <= MAX_PUSH_NS):
-            raise UsageError(f"--push must be a non-zero impulse of at most {MAX_PUSH_NS:g} N s (positive to the left), "
-                             f"got {push!r}")
-        if getattr(args, "boom", False) or getattr(args, "free_pitch", False):
-            raise UsageError("--push: a sideways push needs a free-floating torso (the boom holds it sideways)")
+    args.push, args.push_direction_deg = parse_push(getattr(args, "push", None))
+    if args.push is not None and (getattr(args, "boom", False) or getattr(args, "free_pitch", False)):
+        raise UsageError("--push: a sideways push needs a free-floating torso (the boom holds it sideways)")
+    check_sim_model(args)
     import_mujoco()
     if getattr(args, "video", None):
         check_video_path(args.video)

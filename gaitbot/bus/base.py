@@ -177,6 +177,12 @@ class Bus(ABC):
         now that the robot is safe; buses with nothing more to read return it as it is."""
         return exc
 
+    def read_device(self, device_id: int, address: int, length: int, budget_s: float) -> bytes | None:
+        """One READ of a device on the bus that is not a servo (the OP3's OpenCR IMU) within ``budget_s``,
+        never retried, never waited on beyond it: its bytes, or None when it did not answer in time (or said
+        an error). Buses that talk to no device have none: None."""
+        return None
+
     def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
         """Write a setting (a gain, a lock flag) to each servo, waiting for each one's status packet.
 
@@ -241,6 +247,9 @@ class BusLayer(Bus):
 
     def read_back(self, servo_id: int, budget_s: float) -> ReadBack:
         return self.inner.read_back(servo_id, budget_s)
+
+    def read_device(self, device_id: int, address: int, length: int, budget_s: float) -> bytes | None:
+        return self.inner.read_device(device_id, address, length, budget_s)
 
     def write_register(self, ids: Iterable[int], address: int, length: int, value: int) -> None:
         self.inner.write_register(ids, address, length, value)

@@ -32,6 +32,17 @@ class BudgetedReadBack:
                                  f"present position ({start}..{start + size})")
         self.read_back_blocks = dict(blocks)
 
+    def read_device(self, device_id: int, address: int, length: int, budget_s: float) -> bytes | None:
+        """One budgeted READ of a non-servo device (Bus.read_device: the OP3's OpenCR IMU): the read-back's
+        exchange without its bookkeeping of late replies (a reply after its budget is dropped as stale input)."""
+        self._require_open()
+        if not budget_s >= MIN_READ_BACK_BUDGET_S:
+            return None
+        _, frame = self._budgeted_read(device_id, address, length, budget_s, self.clock())
+        if frame is None or frame.error or len(frame.params) != length:
+            return None
+        return bytes(frame.params)
+
     def read_back(self, servo_id: int, budget_s: float) -> ReadBack:
         """One READ of the servo's read-back block (``set_read_back_blocks``) that waits at most ``budget_s`` on
         the bus's clock and is never retried: the per-frame read of a walk session.

@@ -324,7 +324,7 @@ def check_recording(config: RobotConfig, path: str | Path, margin_deg: float = 0
     issues += match_config(path, header, config)
     names = {j.id: j.name for j in config.joints}
     column = {j.id: c for c, j in enumerate(config.joints)}
-    known = set(column)
+    known = set(column) | set(config.imu.device_ids)  # the IMU (the OP3's OpenCR) answers on the bus too
     model = config.joints[0].model
     goal_addr, goal_len = model.addr_goal_position, model.len_goal_position
     signed = goal_len == 4  # Dynamixel X goal position is a signed 32-bit register

@@ -225,6 +225,9 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
             return
         if self.framing == "v2" and frame.instruction == wire.INST_STATUS_V2:
             return  # a status packet on the line is not for us
+        if self.config.imu is not None and frame.packet_id == self.config.imu.device_id:
+            self._imu_answer(frame)
+            return
         self._instruction = frame.instruction
         self._instruction_rate = self.line_baud
         first_reply = len(self.outbox)
@@ -235,6 +238,16 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
         self._use(self._primary)
         self._collide(first_reply, frame)
         self._log_goals(raw, frame)
+
+    def _imu_answer(self, frame: wire.Frame) -> None:
+        """The IMU device's status packet, on the line after what is already on it (its Return Delay Time is 0)."""
+        packet = self.config.imu.answer(frame, self.now_s)
+        if packet is None:
+            return
+        send_s = max(self.now_s, self._busy_until_s)
+        self._busy_until_s = send_s + len(packet) * 10 / (self.line_baud or self.baudrate)
+        self.rx_packets.append(packet)
+        self.outbox.append((send_s, packet, self.line_baud))
 
     def _log_goals(self, raw: bytes, frame: wire.Frame) -> None:
         if frame.instruction != wire.INST_SYNC_WRITE:

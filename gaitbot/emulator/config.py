@@ -80,6 +80,7 @@ class EmulatorConfig:
     temperatures_c: dict[int, float] = field(default_factory=dict)  # servo id -> temperature at the start
     supply_v: float | None = None  # None: the first servo's usual supply (its Present Voltage factory value)
     voltage_sag_v_per_s: float = 0.0  # the supply falls this fast once faults are active
+    imu: object | None = None  # an IMU device on the line (gaitbot.bus.imu_device.ImuDevice), answering at its id
     model_numbers: dict[int, int] = field(default_factory=dict)  # servo id -> the model number it reports
 
 

@@ -37,6 +37,7 @@ from gaitbot.gait.walker import WalkSettings, make_context
 from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
 from gaitbot.robot.gains import GainError, gain_for_error
 from gaitbot.robot.health import HealthSettings, read_health
+from gaitbot.robot.imu_settings import ImuSettings, read_imu
 from gaitbot.servos import BACKENDS, feetech, max_servo_id, vendor
 from gaitbot.servos.budget import FrameBudget, check_rate
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
@@ -186,6 +187,7 @@ class RobotConfig:
     boom: bool = False
     draft: str | None = None  # [robot] draft: a config imported with placeholders (hardware refuses it)
     steer: SteerLimits | None = None  # [steer]: steering limits (gaitbot.robot.steer_settings); None: straight only
+    imu: ImuSettings = ImuSettings()  # [imu], [feedback], [fall] (gaitbot.robot.imu_settings)
 
     @cached_property
     def body(self) -> BodyModel:
@@ -342,7 +344,7 @@ MASS_TOLERANCE_KG = 1e-4
 """``[mass] total_kg`` must equal the links' sum within this (0.1 g: the files hold 6 digits)."""
 
 _TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain", "health", "balance", "links",
-             "steer")
+             "steer", "imu", "feedback", "fall")
 _MASS_KEYS = ("torso_kg", "thigh_kg", "shank_kg", "foot_kg", "total_kg")
 _LINK_NAMES = ("torso",) + LEG_LINKS
 _LINK_KEYS = ("mass_kg", "com_m", "inertia_kg_m2")
@@ -389,7 +391,7 @@ class _Reader(Fields):
         balance = self.balance(self.optional_table(data, "balance", "balance", BalanceSettings.field_names()))
         config = RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
                              mass=mass, servo=servo, terrain=terrain, health=health, balance=balance, links=links,
-                             boom=boom, draft=draft, steer=read_steer(self, data))
+                             boom=boom, draft=draft, steer=read_steer(self, data), imu=read_imu(self, data, bus))
         self.three_d_checks(config)
         return config
 

@@ -167,7 +167,9 @@ class SimReport:
                          f"({len(self.heel_strikes)} measured)")
             text += "."
         if self.push is not None:
-            text += (f"\nPushed {self.push['impulse_n_s']:+.2f} N s sideways at {self.push['start_s']:.2f} s, "
+            direction = self.push.get("direction_deg", 90.0)
+            way = "sideways" if direction == 90.0 else f"towards {direction:g} deg from forward"
+            text += (f"\nPushed {self.push['impulse_n_s']:+.2f} N s {way} at {self.push['start_s']:.2f} s, "
                      f"mid-swing of step {self.push['step']} ({self.push['leg']} foot swinging).")
         return text
 
@@ -241,8 +243,7 @@ class WalkMeter:
     def _check_fall(self, robot: SimRobot, t: float, torso: np.ndarray, contacts) -> None:
         if self.fell_at_s is not None:
             return
-        soles = set(robot.sole_geoms.tolist())
-        others = sorted({robot.model.geom(g).name for g, _ in contacts if g not in soles})
+        others = sorted({robot.model.geom(g).name or f"geom {g}" for g, _ in contacts if g not in robot.sole_side_of})
         tilt = self._tilt_deg(robot)
         reason = None
         if others:
@@ -273,7 +274,8 @@ class WalkMeter:
             body = robot.foot_bodies[side]
             pos, rot = robot.data.xpos[body], robot.data.xmat[body].reshape(3, 3)
             sign = 1.0 if strike.leg == "left" else -1.0
-            point = pos + rot @ np.array([-g.heel_back_m, sign * g.sole_outward_m, 0.0])
+            heel = robot.foot_axes[side] @ np.array([-g.heel_back_m, sign * g.sole_outward_m, 0.0])
+            point = pos + rot @ (robot.ankle_in_foot_m[side] + heel)
             x, y = float(point[0]) + plan.x_origin_m, float(point[1])
             if strike.y_m is None:
                 error = abs(x - strike.x_m)
@@ -284,8 +286,8 @@ class WalkMeter:
 
     def _measure_slip(self, robot: SimRobot, contacts) -> None:
         data = robot.data
-        for side, (geom, body) in enumerate(zip(robot.sole_geoms, robot.foot_bodies)):
-            points = [p for g, p in contacts if g == geom]
+        for side, body in enumerate(robot.foot_bodies):
+            points = [p for g, p in contacts if robot.sole_side_of.get(g) == side]
             pose = (data.xpos[body].copy(), data.xmat[body].reshape(3, 3).copy())
             if not points:
                 self._last_pose[side] = None

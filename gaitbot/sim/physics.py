@@ -65,8 +65,12 @@ class SimRobot:
         self.torque_on = np.zeros(len(self.drives), dtype=bool)
         self.floor_geom = model.geom("floor").id
         self.sole_geoms = np.array([model.geom(f"sole_{side}").id for side in SIDES])
+        self.sole_side_of = {int(g): side for side, g in enumerate(self.sole_geoms)}  # geom -> index in SIDES
         self.foot_bodies = np.array([model.body(f"foot_{side}").id for side in SIDES])
+        self.ankle_in_foot_m = np.zeros((len(SIDES), 3))  # the ankle point in each foot body (its origin here)
+        self.foot_axes = np.array([np.eye(3)] * len(SIDES))  # gaitbot's foot axes in each foot body
         self.torso_body = model.body("torso").id
+        self.imu_body = self.torso_body  # the body the simulated IMU reads (gaitbot.sim.imu)
         self._touch_adr = np.array([model.sensor(f"touch_{side}").adr[0] for side in SIDES])
         if list(self.actuator_index) != list(range(model.nu)) or list(self._touch_adr) != list(range(model.nsensordata)):
             raise RuntimeError("the model's actuators and sensors must be in joint and side order")  # build_mjcf's
@@ -156,8 +160,10 @@ class SimRobot:
         data.qvel[:] = 0.0
         self.mujoco.mj_forward(model, data)
 
-    def push(self, force_y_n: float) -> None:
-        """A sideways force on the torso's centre of mass (N, positive to the left) until changed."""
+    def push(self, force_y_n: float, force_x_n: float = 0.0) -> None:
+        """A horizontal force on the torso's centre of mass (N; y positive to the left, x forward in the
+        world) until changed."""
+        self.data.xfrc_applied[self.torso_body, 0] = force_x_n
         self.data.xfrc_applied[self.torso_body, 1] = force_y_n
 
     def advance_to(self, t_s: float) -> None:

@@ -31,18 +31,27 @@ from gaitbot.bus.recording import BusRecorder
 from gaitbot.bus.dry_run import DryRunPort
 from gaitbot.robot.calibration import angle_rad_to_ticks, ticks_to_angle_rad
 from gaitbot.robot.config import RobotConfig
+from gaitbot.servos import opencr
 from gaitbot.servos.registers import overlaps
+from gaitbot.sim.imu import SimImu
 from gaitbot.sim.physics import SimRobot
 
 
 class SimPort(DryRunPort):
     """A DryRunPort whose walking servos are ``robot``'s joints, on the time ``now()`` tells (seconds)."""
 
-    def __init__(self, config: RobotConfig, robot: SimRobot, now: Callable[[], float], port_name: str = "sim") -> None:
+    def __init__(self, config: RobotConfig, robot: SimRobot, now: Callable[[], float], port_name: str = "sim",
+                 imu_seed: int = 0, imu_fault: str | None = None) -> None:
         super().__init__(config.bus.backend, config.bus.protocol, config.models_by_id, port_name=port_name,
                          baudrate=config.bus.baudrate)
         self.robot = robot
         self.now = now
+        self.imu = self.imu_id = None
+        if config.imu.source == "opencr":  # the OP3's OpenCR on the same bus, its IMU the simulated one
+            self.imu_id = config.imu.device_id
+            self.tables[self.imu_id] = opencr.initial_table()
+            self.imu = SimImu(robot, config.imu, self.tables[self.imu_id], robot.imu_body, imu_seed, imu_fault)
+            robot.observers.append(self.imu)
         walking = [config.joint(name) for name in robot.joint_names]  # the joints the model has, in its order
         self.joint_of = {j.id: i for i, j in enumerate(walking)}
         self._ids = [j.id for j in walking]
@@ -73,7 +82,25 @@ class SimPort(DryRunPort):
             self.tables[servo_id][start:start + model.len_present_position] = \
                 tick.to_bytes(model.len_present_position, model.byte_order)
 
+    def hears(self, servo_id: int) -> bool:
+        if servo_id == self.imu_id:
+            return self.imu.answering
+        return super().hears(servo_id)
+
+    def _targets(self, packet_id: int) -> list[int]:
+        """The IMU device answers what is sent to its id (a broadcast ping finds the servos only)."""
+        return [i for i in super()._targets(packet_id) if i != self.imu_id or packet_id == self.imu_id]
+
+    def _ping(self, frame) -> None:
+        if frame.packet_id == self.imu_id and self.imu is not None and self.imu.answering:
+            self._reply(self.imu_id, bytes(self.tables[self.imu_id][0:2]) + bytes([opencr.OPENCR_OP3_FIRMWARE]))
+            return
+        super()._ping(frame)
+
     def _store(self, servo_id: int, address: int, data: bytes) -> None:
+        if servo_id == self.imu_id:  # a setting of the device (LED, IMU Control): kept, no effect on the physics
+            self.tables[servo_id][address:address + len(data)] = data
+            return
         joint = self.joint_of.get(servo_id)
         if joint is None:
             super()._store(servo_id, address, data)  # a held joint: an ideal servo
@@ -94,13 +121,13 @@ class SimPort(DryRunPort):
 
 
 def make_sim_bus(config: RobotConfig, robot: SimRobot, now: Callable[[], float],
-                 recorder: BusRecorder | None = None) -> Bus:
+                 recorder: BusRecorder | None = None, imu_seed: int = 0, imu_fault: str | None = None) -> Bus:
     """The robot's own bus class (Dynamixel or Feetech, with its SDK) on a SimPort whose physics follows
     ``now()`` (the streamer's clock, e.g. ``VirtualClock().now``).
 
     Like a dry run, but the servos are ``robot``'s joints; the bus is not opened here."""
     cls = bus_class(config.bus.backend)
-    handler = SimPort(config, robot, now)
+    handler = SimPort(config, robot, now, imu_seed=imu_seed, imu_fault=imu_fault)
     if recorder is not None:
         handler = recorder.wrap(handler, backend=config.bus.backend, protocol=config.bus.protocol,
                                 baudrate=config.bus.baudrate, models=config.models_by_id)

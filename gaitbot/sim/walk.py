@@ -11,6 +11,7 @@ starting in the middle of the swing of the step half-way through the walk.
 from __future__ import annotations
 
 import json
+import math
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -63,29 +64,32 @@ def walk_plan(walker, trajectory: Trajectory) -> WalkPlan:
 
 @dataclass(frozen=True)
 class Push:
-    """A sideways impulse (N s, positive to the left) from start_s, in the swing of step ``step``."""
+    """An impulse (N s) from start_s, in the swing of step ``step``, horizontal, ``direction_deg`` from
+    forward (the walk's +x), counter-clockwise: 90 (the default) pushes to the left, and a negative
+    impulse the opposite way."""
 
     impulse_n_s: float
     start_s: float
     step: int
     leg: str
+    direction_deg: float = 90.0
 
     @property
     def end_s(self) -> float:
         return self.start_s + PUSH_DURATION_S
 
     def to_dict(self) -> dict:
-        return {"impulse_n_s": self.impulse_n_s, "start_s": self.start_s, "end_s": self.end_s, "step": self.step,
-                "leg": self.leg}
+        return {"impulse_n_s": self.impulse_n_s, "direction_deg": self.direction_deg, "start_s": self.start_s,
+                "end_s": self.end_s, "step": self.step, "leg": self.leg}
 
 
-def mid_walk_push(plan: WalkPlan, impulse_n_s: float) -> Push:
+def mid_walk_push(plan: WalkPlan, impulse_n_s: float, direction_deg: float = 90.0) -> Push:
     """The push of ``--push``: at the middle of the swing of the step half-way through the walk."""
     if not plan.swings:
         raise ValueError("the walk has no steps to push in")
     index = len(plan.swings) // 2
     window = plan.swings[index]
-    return Push(impulse_n_s, 0.5 * (window.start_s + window.end_s), index + 1, window.leg)
+    return Push(impulse_n_s, 0.5 * (window.start_s + window.end_s), index + 1, window.leg, direction_deg)
 
 
 class Pusher:
@@ -95,25 +99,36 @@ class Pusher:
         self.push = push
         frames = max(1, round(PUSH_DURATION_S / frame_s))
         self.force_n = push.impulse_n_s / (frames * frame_s)
+        angle = math.radians(push.direction_deg)
+        self.force_xy_n = (self.force_n * math.cos(angle), self.force_n * math.sin(angle))
         self.frames_left = frames
 
     def __call__(self, robot) -> None:
         on = self.frames_left > 0 and robot.time_s + 1e-9 >= self.push.start_s
         if on:
             self.frames_left -= 1
-        robot.push(self.force_n if on else 0.0)
+        robot.push(self.force_xy_n[1] if on else 0.0, self.force_xy_n[0] if on else 0.0)
 
 
 class SimWalk:
     """The simulated robot of one walk, its measurements and, if asked, its video and push."""
 
     def __init__(self, config: RobotConfig, rate_hz: float, plan: WalkPlan, support: str = "free",
-                 video: str | None = None, push_n_s: float | None = None) -> None:
+                 video: str | None = None, push_n_s: float | None = None, push_direction_deg: float = 90.0,
+                 foreign: tuple | None = None, imu_seed: int = 0, imu_fault: str | None = None) -> None:
+        """``foreign``: (model file, SimMap) of another author's model (gaitbot.sim.foreign), else gaitbot's own."""
         from gaitbot.sim.physics import SimRobot
 
         self.config = config
         self.plan = plan
-        self.robot = SimRobot(config, rate_hz, support=support)
+        self.imu_seed, self.imu_fault = imu_seed, imu_fault
+        self.extra: dict = {}  # more for the JSON object (the feedback mode, the fall the IMU noticed)
+        if foreign is not None:
+            from gaitbot.sim.foreign import ForeignRobot
+
+            self.robot = ForeignRobot(config, rate_hz, *foreign)
+        else:
+            self.robot = SimRobot(config, rate_hz, support=support)
         if self.robot.planar:  # today's planar model starts standing straight, its hip at x = 0
             self.plan = plan = replace(plan, x_origin_m=plan.start_root_m[0] if plan.start_root_m else 0.0)
         elif plan.start_angles_rad is not None:  # the 3D model stands in the walk's first pose, in its world
@@ -122,7 +137,7 @@ class SimWalk:
         self.robot.observers.append(self.meter)
         self.push = None
         if push_n_s:
-            self.push = mid_walk_push(plan, push_n_s)
+            self.push = mid_walk_push(plan, push_n_s, push_direction_deg)
             self.robot.observers.append(Pusher(self.push, self.robot.frame_s))
         self.video = None
         if video:
@@ -135,7 +150,15 @@ class SimWalk:
         """The robot's bus on the simulated chain, its physics following ``now()`` (the session's clock)."""
         from gaitbot.sim.port import make_sim_bus
 
-        return make_sim_bus(self.config, self.robot, now, recorder)
+        return make_sim_bus(self.config, self.robot, now, recorder, self.imu_seed, self.imu_fault)
+
+    def tilt_crossed_s(self, threshold_deg: float) -> float | None:
+        """When the torso's true tilt (hypot of roll and pitch, the IMU estimate's measure) first passed
+        ``threshold_deg`` (frame ends), or None: the yardstick of how soon a fall is noticed."""
+        for t_s, rpy in zip(self.meter.times_s, self.meter.rpy_deg):
+            if math.hypot(rpy[0], rpy[1]) > threshold_deg:
+                return float(t_s)
+        return None
 
     def report(self) -> SimReport:
         return self.meter.report(self.plan, self.robot.free_pitch,
@@ -147,7 +170,7 @@ class SimWalk:
         report = self.report()
         frames = self.video.save(on_progress) if self.video is not None else 0
         if as_json:
-            print(json.dumps({"robot": self.config.name, "outcome": outcome, **report.to_dict(),
+            print(json.dumps({"robot": self.config.name, "outcome": outcome, **report.to_dict(), **self.extra,
                               "video": str(self.video.path) if self.video is not None else None}, indent=2))
         else:
             print(report.summary())

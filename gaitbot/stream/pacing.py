@@ -170,7 +170,7 @@ class Streamer:
                  late_threshold_s: float = LATE_THRESHOLD_S,
                  min_frame_interval_s: float | None = None,
                  cpu_time_s: Callable[[], float] = time.process_time,
-                 monitor: Callable[[float], None] | None = None) -> None:
+                 monitor: Callable[[float], None] | None = None, feedback=None) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be > 0, got {period_s}")
         self.bus = bus
@@ -184,6 +184,7 @@ class Streamer:
         self.min_frame_interval_s = 0.9 * self.period_s if min_frame_interval_s is None else min_frame_interval_s
         self.cpu_time_s = cpu_time_s
         self.monitor = monitor
+        self.feedback = feedback  # gaitbot.feel.Feedback: corrects each row from the IMU (None: as planned)
         self.stats = StreamStats(period_s=self.period_s, late_threshold_s=late_threshold_s)
         self.last_sent_ticks: np.ndarray | None = None
         self.previous_sent_ticks: np.ndarray | None = None
@@ -224,13 +225,14 @@ class Streamer:
                 work_cpu_start = cpu()
                 # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
                 # time: converting a whole one-hour walk up front would take ~100 MB.
-                goals = dict(zip(ids, frame.tolist()))
+                row = frame if self.feedback is None else self.feedback.correct(k, frame)
+                goals = dict(zip(ids, row.tolist()))
                 # The pacing rule on the wire itself: had the host paused between the previous frame's
                 # start and its write, this write still waits the minimum interval after that one.
                 if last_write_s is not None and clock.now() < last_write_s + min_interval_s:
                     clock.sleep_until(last_write_s + min_interval_s)
                 last_write_s = self.last_send_s = clock.now()
-                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frame
+                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, row
                 bus.write_goal_ticks(goals)
                 # The grid moves on as soon as the goals went out: whatever the read-back raises, the
                 # next frame sent (a stop ramp's first) is due one period after this one, not at once.

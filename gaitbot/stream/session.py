@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike
 
 from gaitbot.bus.base import Bus, BusError, PortError, RegisterWrite
 from gaitbot.bus.recording import RecordingFailed
+from gaitbot.feel.feedback import RobotFell
 from gaitbot.stream.clock import Clock, MonotonicClock
 from gaitbot.stream.health import HealthMonitor, ServoHealthStop
 from gaitbot.stream.pacing import FrameSource, StopRequestedError, StreamStats, Streamer, as_tick_frames, tick_frames
@@ -39,6 +40,7 @@ class Outcome(str, Enum):
     TERMINATED = "terminated"  # SIGTERM
     BUS_ERROR = "bus_error"
     HEALTH_STOP = "health_stop"  # a servo's temperature or voltage reached its stop threshold
+    FELL = "fell"  # the IMU said the robot fell (gaitbot.feel): stepping stopped, the CoM lowered
 
     def __str__(self) -> str:
         return self.value
@@ -153,7 +155,7 @@ class SessionResult:
     def message(self) -> str:
         head = {"completed": "Walk completed", "interrupted": "Walk interrupted (Ctrl-C)",
                 "terminated": "Walk terminated (SIGTERM)", "bus_error": "Walk stopped by a bus error",
-                "health_stop": "Walk stopped to protect a servo"}
+                "health_stop": "Walk stopped to protect a servo", "fell": "Walk stopped: the robot fell"}
         parts = [head.get(self.outcome, str(self.outcome))]
         if isinstance(self.error, RecordingFailed):
             parts = ["Walk stopped because the recording failed (the serial port is fine)"]
@@ -179,13 +181,17 @@ class WalkSession:
     ramp, the walk and the final ramp (gaitbot.stream.readback); a stop ramp after a fault is not read
     back (it must reach the healthy servos whatever the faulty one does). ``handle_signals``: SIGINT and
     SIGTERM only set a flag while the session runs (main thread only; the old handlers come back after).
+    ``feedback`` (gaitbot.feel.Feedback): during the walk, the IMU is read after the read-back in the same
+    frame's budget and each frame's goals are corrected from it; a fall it notices (RobotFell) stops the
+    stepping and brakes into the fall pose (the CoM lowered), then the config's response (docs/feedback.md).
     """
 
     def __init__(self, bus: Bus, ids: Sequence[int], stand_ticks: ArrayLike, limits: SessionLimits, *,
                  clock: Clock | None = None, torque_off_on_exit: bool = False,
                  setup_writes: Sequence[RegisterWrite] = (), health: HealthMonitor | None = None,
-                 monitor_servos: bool = True, handle_signals: bool = True) -> None:
+                 monitor_servos: bool = True, handle_signals: bool = True, feedback=None) -> None:
         self.bus = bus
+        self.feedback = feedback
         self.ids = [int(i) for i in ids]
         self.stand = as_tick_frames(np.asarray(stand_ticks).reshape(1, -1), len(self.ids))[0]
         self.limits = limits
@@ -232,7 +238,7 @@ class WalkSession:
 
     def stream(self, frames: FrameSource, on_frame: Callable[[int, StreamStats], None] | None = None) -> StreamStats:
         """Stream the frames, each when it is due; a deferred signal stops it between two frames."""
-        self._run(self._streamer(on_frame, monitored=True), frames, is_walk=True, watch_signals=True)
+        self._run(self._streamer(on_frame, monitored=True, felt=True), frames, is_walk=True, watch_signals=True)
         return self.state.walk_stats
 
     def stop(self, monitored: bool = False) -> bool:
@@ -339,6 +345,9 @@ class WalkSession:
             outcome, error = (Outcome.TERMINATED if isinstance(exc, Terminated) else Outcome.INTERRUPTED), None
         except ServoHealthStop as exc:  # a servo too hot or under-powered: the safe stop of a bus fault
             outcome, error = Outcome.HEALTH_STOP, exc
+        except RobotFell as exc:  # stop stepping, lower the CoM, then the config's response (gaitbot.feel)
+            self._fall_stop()
+            return Outcome.FELL, exc
         except BusError as exc:
             if isinstance(exc, PortError) and self.state.torque_on:
                 self.state.port_lost = True
@@ -361,6 +370,22 @@ class WalkSession:
         except BusError as exc:
             self.state.notes.append(f"stop ramp abandoned: {exc}")
 
+    def _fall_stop(self) -> None:
+        """A fall: brake from the motion under way into the fall pose (the legs folded: the CoM lower), then
+        torque off if the robot's [fall] response says so (the ramp finishes whatever signals arrive)."""
+        state, feedback = self.state, self.feedback
+        if feedback.settings.fall_response == "torque_off":
+            self.torque_off_on_exit = True
+        if not state.torque_on or state.last_sent is None:
+            return
+        previous = state.previous_sent if state.previous_sent is not None else state.last_sent
+        ramp = self.limits.stop(previous, state.last_sent, feedback.fall_pose(state.last_sent))
+        try:
+            self._run(self._streamer(), ramp)
+            state.notes.append(f"{feedback.settings.fall_response.replace('_', ' ')} after lowering the CoM")
+        except BusError as exc:
+            state.notes.append(f"fall stop abandoned: {exc}")
+
     def _explain(self, exc: BusError) -> BaseException:
         """The fault in words, read once the robot is safe (a bus may read the servo's error register)."""
         try:
@@ -377,9 +402,13 @@ class WalkSession:
     def _stop_requested(self) -> bool:
         return bool(self.signals is not None and self.signals.pending)
 
-    def _streamer(self, on_frame=None, monitored: bool = False) -> Streamer:
-        return Streamer(self.bus, self.ids, self.limits.period_s, self.clock, on_frame,
-                        monitor=self.read_back if monitored else None)
+    def _streamer(self, on_frame=None, monitored: bool = False, felt: bool = False) -> Streamer:
+        monitor = self.read_back if monitored else None
+        feedback = self.feedback if felt else None
+        if feedback is not None:  # the IMU read after the read-back, in the same frame's budget
+            monitor = _both(monitor, feedback.sense)
+        return Streamer(self.bus, self.ids, self.limits.period_s, self.clock, on_frame, monitor=monitor,
+                        feedback=feedback)
 
     def _run(self, streamer: Streamer, frames: FrameSource, is_walk: bool = False, watch_signals: bool = False) -> None:
         self.state.run(streamer, frames, is_walk, self._stop_requested if watch_signals else None)
@@ -399,7 +428,8 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: FrameSource, stand_ticks:
                  torque_off_on_exit: bool = False,
                  on_frame: Callable[[int, StreamStats], None] | None = None,
                  handle_sigterm: bool = True, monitor_servos: bool = True,
-                 setup_writes: Sequence[RegisterWrite] = (), health: HealthMonitor | None = None) -> SessionResult:
+                 setup_writes: Sequence[RegisterWrite] = (), health: HealthMonitor | None = None,
+                 feedback=None) -> SessionResult:
     """One :class:`WalkSession` run, in one call (the public API's shape: ``gaitbot.walk_session``).
 
     ``handle_sigterm``: SIGINT and SIGTERM set the session's stop flag while it runs (main thread only);
@@ -407,7 +437,7 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: FrameSource, stand_ticks:
     limits = SessionLimits(max_velocity_ticks_per_s, max_accel_ticks_per_s2, period_s)
     session = WalkSession(bus, ids, stand_ticks, limits, clock=clock, torque_off_on_exit=torque_off_on_exit,
                           setup_writes=setup_writes, health=health, monitor_servos=monitor_servos,
-                          handle_signals=handle_sigterm)
+                          handle_signals=handle_sigterm, feedback=feedback)
     return session.run(frames, on_frame)
 
 
@@ -445,3 +475,15 @@ class _SessionState:
                 self.walk_stats = streamer.stats
         if is_walk:
             self.walk_stats = stats
+
+
+def _both(first: Callable[[float], None] | None, second: Callable[[float], None]) -> Callable[[float], None]:
+    """Two per-frame monitors, one after the other (the read-back, then the IMU read)."""
+    if first is None:
+        return second
+
+    def both(deadline_s: float) -> None:
+        first(deadline_s)
+        second(deadline_s)
+
+    return both

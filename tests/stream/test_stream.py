@@ -668,7 +668,8 @@ def test_unexpected_error_still_stops_safely_closes_and_reraises():
 
 def test_exit_codes_are_the_shell_conventions():
     assert EXIT_CODES == {"completed": 0, "interrupted": 128 + signal.SIGINT,
-                          "terminated": 128 + signal.SIGTERM, "bus_error": 1, "health_stop": 1}
+                          "terminated": 128 + signal.SIGTERM, "bus_error": 1, "health_stop": 1,
+                          "fell": 1}  # the IMU noticed a fall (gaitbot.feel)
 
 
 # --------------------------------------------------------------------------- latency timer

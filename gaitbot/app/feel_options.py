@@ -1,0 +1,57 @@
+"""``--feedback none|gyro|full`` of a walk: the IMU reader and the feedback of gaitbot.feel, or open loop."""
+
+from __future__ import annotations
+
+import sys
+
+from gaitbot.app.options import UsageError
+
+FEEDBACK_CHOICES = ("none", "gyro", "full")
+
+
+def add_feedback_option(p) -> None:
+    p.add_argument("--feedback", choices=FEEDBACK_CHOICES, help="correct the goals from the robot's IMU: none (open "
+                   "loop), gyro (gyro damping of ankles and hips), full (and the estimated tilt); default: all the "
+                   "robot's [imu] allows (docs/feedback.md). A fall the IMU notices stops the walk (exit 1)")
+
+
+def feedback_mode(args, config) -> str:
+    """The mode asked for, or the robot's best; a robot without an IMU walks open loop and says so once."""
+    asked = getattr(args, "feedback", None)
+    if not config.imu.present:
+        if asked not in (None, "none"):
+            raise UsageError(f"--feedback {asked}: robot {config.name} has no IMU ([imu] source = \"none\")")
+        print(f"note: robot {config.name} has no IMU ([imu]): walking open loop", file=sys.stderr)
+        return "none"
+    return asked or "full"
+
+
+def make_feedback(config, mode: str, bus, clock, period_s: float):
+    """The Feedback of a walk (None open loop without an IMU); its IMU faults are said once, on stderr."""
+    if not config.imu.present:
+        return None
+    from gaitbot.feel.feedback import Feedback
+    from gaitbot.feel.imu_reader import ImuReader
+
+    def warn(text: str) -> None:
+        print(f"\nwarning: {text}" if sys.stderr.isatty() else f"warning: {text}", file=sys.stderr, flush=True)
+
+    reader = ImuReader(bus, config.imu, clock.now, period_s, on_fault=warn)
+    return Feedback(config, mode, reader, period_s, clock.now)
+
+
+def fall_line(result, feedback) -> str | None:
+    """The line that says when and which way the robot fell (the session's outcome "fell"), or None."""
+    if result.outcome != "fell" or result.error is None:
+        return None
+    fell = result.error
+    return f"The robot fell {fell.direction} at {fell.t_s:.2f} s ({fell.reason}); noticed by the IMU."
+
+
+def fall_dict(result, true_tilt_crossed_s: float | None = None) -> dict | None:
+    """The fall the IMU noticed, for --json; in the simulation also when the true tilt crossed the threshold."""
+    if result.outcome != "fell" or result.error is None:
+        return None
+    fell = result.error
+    return {"t_s": round(fell.t_s, 4), "direction": fell.direction, "reason": fell.reason,
+            "true_tilt_crossed_s": None if true_tilt_crossed_s is None else round(true_tilt_crossed_s, 4)}

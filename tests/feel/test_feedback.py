@@ -1,0 +1,139 @@
+"""gaitbot.feel: the tilt estimate, the gyro damping's direction (checked with gaitbot's leg kinematics), and
+that no correction ever takes a goal outside a joint's position, velocity or acceleration limits (checked from
+the config's limits directly)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gaitbot.feel.estimate import TIME_CONSTANT_S, TiltEstimate
+from gaitbot.feel.feedback import Feedback, RobotFell
+from gaitbot.gait.kinematics6 import foot_pose
+from gaitbot.robot.calibration import angles_to_ticks, ticks_to_angles
+from gaitbot.servos.opencr import ImuReading
+from helpers import config
+
+PERIOD_S = 1 / 60
+
+
+class StubReader:
+    """An IMU reader that returns the readings it is given (the bus is not the point here)."""
+
+    fault = None
+
+    def __init__(self) -> None:
+        self.next: ImuReading | None = None
+
+    def read(self, deadline_s: float) -> ImuReading | None:
+        return self.next
+
+
+def strong_op3(**imu):
+    cfg = config("op3")
+    return dataclasses.replace(cfg, imu=dataclasses.replace(cfg.imu, ankle_pitch_s=0.5, hip_pitch_s=0.5, ankle_roll_s=0.5,
+                                                            hip_roll_s=0.5, attitude_gain=1.0, max_correction_deg=30.0,
+                                                            fall_tilt_deg=89.0, fall_tilt_rate_dps=2000.0, **imu))
+
+
+def reading(gyro_dps, acc_g=(0.0, 0.0, 1.0)) -> ImuReading:
+    return ImuReading(np.asarray(gyro_dps, float), np.asarray(acc_g, float), np.zeros(3))
+
+
+def test_a_still_tilted_torso_is_estimated_from_gravity_and_a_gyro_bias_errs_by_bias_times_tau():
+    est = TiltEstimate(PERIOD_S)
+    tilt = math.radians(10.0)
+    for _ in range(600):  # 10 s still, pitched 10 deg forward, gyro biased 2 deg/s in pitch
+        est.update(reading([0.0, 2.0, 0.0], [-math.sin(tilt), 0.0, math.cos(tilt)]))
+    assert est.pitch_deg == pytest.approx(10.0 + 2.0 * TIME_CONSTANT_S, abs=0.05)
+    assert est.roll_deg == pytest.approx(0.0, abs=1e-9)
+    assert est.direction() == "forwards"
+
+
+def stance_torso_pitch_roll(cfg, angles_by_name: dict, side: str) -> tuple[float, float]:
+    """The torso's world pitch and roll (deg) when ``side``'s foot is flat on the floor (gaitbot's kinematics)."""
+    q = [angles_by_name[f"{k}_{side}"] for k in ("hip_yaw", "hip_roll", "hip_pitch", "knee_pitch", "ankle_pitch",
+                                                  "ankle_roll")]
+    _, foot = foot_pose(cfg.body.geometry, side, np.array(q))
+    torso = foot.T  # the foot flat (identity in the world): the torso's rotation is the foot's inverse
+    return math.degrees(math.atan2(-torso[2, 0], torso[2, 2])), math.degrees(math.atan2(torso[2, 1], torso[2, 2]))
+
+
+@pytest.mark.parametrize("gyro, index, sign", [([0.0, 50.0, 0.0], 0, -1), ([0.0, -50.0, 0.0], 0, 1),
+                                               ([50.0, 0.0, 0.0], 1, -1), ([-50.0, 0.0, 0.0], 1, 1)])
+def test_gyro_damping_turns_the_torso_against_its_rate_on_either_stance_leg(gyro, index, sign):
+    cfg = strong_op3()
+    names = [j.name for j in cfg.joints]
+    crouch = {n: math.radians({"hip_pitch": 30, "knee_pitch": 60, "ankle_pitch": 30}.get(n.rsplit("_", 1)[0], 0))
+              for n in names}
+    row = angles_to_ticks(cfg, np.array([crouch[n] for n in names]))
+    stub = StubReader()
+    fb = Feedback(cfg, "gyro", stub, PERIOD_S, lambda: 0.0)
+    stub.next = reading(gyro)
+    fb.sense(0.0)
+    corrected = dict(zip(names, ticks_to_angles(cfg, fb.correct(0, row))))
+    for side in ("left", "right"):
+        before = stance_torso_pitch_roll(cfg, crouch, side)[index]
+        after = stance_torso_pitch_roll(cfg, corrected, side)[index]
+        # gyro y > 0: pitching forward (pitch up); gyro x > 0: rolling right, which is roll (about x) up
+        assert sign * (after - before) > 0.5
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.lists(st.tuples(st.floats(-2000, 2000), st.floats(-2000, 2000), st.floats(-0.6, 0.6), st.floats(-0.6, 0.6)),
+                min_size=20, max_size=20), st.integers(0, 10_000))
+def test_no_correction_breaks_a_limit(imu, seed):
+    cfg = strong_op3()
+    joints = cfg.joints
+    rng = np.random.default_rng(seed)
+    t = np.arange(len(imu)) / 60
+    # a smooth plan well inside the limits, near the top of a joint's range for some
+    mid = np.array([(j.min_deg + j.max_deg) / 2 for j in joints])
+    span = np.array([(j.max_deg - j.min_deg) / 2 for j in joints])
+    plan_deg = mid + 0.9 * span * np.sin(0.3 * t[:, None] + rng.uniform(0, 6, len(joints)))
+    rows = angles_to_ticks(cfg, np.radians(plan_deg))
+    stub = StubReader()
+    fb = Feedback(cfg, "full", stub, PERIOD_S, lambda: 0.0)
+    fb._check_fall = lambda: None  # wild readings integrate to any tilt: the limits are the point here
+    sent = []
+    for k, (gx, gy, ax, ay) in enumerate(imu):
+        stub.next = reading([gx, gy, 0.0], [ax, ay, 1.0])
+        fb.sense(k * PERIOD_S)
+        sent.append(fb.correct(k, rows[k]))
+    angles = np.degrees(ticks_to_angles(cfg, np.array(sent)))
+    lo, hi = np.array([j.min_deg for j in joints]), np.array([j.max_deg for j in joints])
+    tick_deg = np.array([360 / (2 * math.pi * j.model.ticks_per_rad) for j in joints])
+    assert np.all(angles >= lo - tick_deg) and np.all(angles <= hi + tick_deg)
+    speed = np.abs(np.diff(angles, axis=0)) * 60
+    assert np.all(speed <= np.array([j.max_velocity_dps for j in joints]) + 60 * tick_deg + 1e-9)
+    accel = np.abs(np.diff(angles, 2, axis=0)) * 3600
+    assert np.all(accel <= np.array([j.max_acceleration_dps2 for j in joints]) + 2 * 3600 * tick_deg + 1e-9)
+
+
+def test_a_tilt_beyond_the_threshold_is_a_fall_with_its_direction():
+    cfg = config("op3")
+    stub = StubReader()
+    now = [0.0]
+    fb = Feedback(cfg, "gyro", stub, PERIOD_S, lambda: now[0])
+    row = angles_to_ticks(cfg, np.zeros(len(cfg.joints)))
+    tilt = math.radians(cfg.imu.fall_tilt_deg + 2)
+    stub.next = reading([0.0, 0.0, 0.0], [0.0, -math.sin(tilt), math.cos(tilt)])  # gravity says: leaning left
+    now[0] = 1.25
+    fb.sense(now[0])
+    with pytest.raises(RobotFell) as fell:
+        fb.correct(0, row)
+    assert fell.value.direction == "sideways (left)" and fell.value.t_s == pytest.approx(1.25)
+
+
+def test_without_a_reading_nothing_is_corrected():
+    cfg = strong_op3()
+    stub = StubReader()
+    fb = Feedback(cfg, "full", stub, PERIOD_S, lambda: 0.0)
+    row = angles_to_ticks(cfg, np.zeros(len(cfg.joints)))
+    fb.sense(0.0)
+    assert np.array_equal(fb.correct(0, row), row)

@@ -1,0 +1,88 @@
+"""The IMU in the simulated walk: read byte-exact on the bus, a fall noticed within 100 ms and handled (exit 1,
+when and which way, the recording checks), a broken IMU noticed and the walk finished open loop."""
+
+from __future__ import annotations
+
+import json
+import struct
+
+import pytest
+
+from gaitbot.sim import SimUnavailable, import_mujoco  # noqa: E402  (picks the offscreen GL first)
+
+try:
+    import_mujoco()
+except SimUnavailable:
+    pytest.skip("the sim extra (MuJoCo) is not installed", allow_module_level=True)
+
+from helpers import crc16, parse_packet, read_lines, run_cli  # noqa: E402
+
+OPENCR_ID = 200
+
+
+def imu_exchanges(path):
+    """(instruction bytes, status bytes) of every exchange with id 200, parsed here from the raw packets."""
+    rows = read_lines(path)[1:]
+    out = []
+    for tx, rx in zip(rows, rows[1:]):
+        if tx["dir"] == "tx" and rx["dir"] == "rx" and bytes.fromhex(tx["hex"])[4] == OPENCR_ID:
+            out.append((bytes.fromhex(tx["hex"]), bytes.fromhex(rx["hex"])))
+    return out
+
+
+def test_the_imu_is_read_every_frame_byte_exact_and_the_recording_checks(tmp_path, capsys):
+    record = tmp_path / "walk.jsonl"
+    code, out, err = run_cli(capsys, "walk", "--sim", "--json", "--robot", "op3", "--distance", "0.3", "--record", record)
+    assert code == 0, err
+    exchanges = imu_exchanges(record)
+    report = json.loads(out)
+    assert len(exchanges) >= 0.9 * report["simulated_s"] * 60 - 120  # every walk frame (not the ramps)
+    # READ (0x02) of 18 bytes from address 32, Protocol 2.0 with its CRC: the packet built by hand
+    body = bytes([0xFF, 0xFF, 0xFD, 0x00, OPENCR_ID, 0x07, 0x00, 0x02, 32, 0, 18, 0])
+    expected = body + crc16(body).to_bytes(2, "little")
+    standing = []
+    for tx, rx in exchanges:
+        assert tx == expected
+        packet_id, instruction, params = parse_packet(rx, 2.0)
+        assert (packet_id, instruction, params[0], len(params)) == (OPENCR_ID, 0x55, 0, 19)
+        gyro = struct.unpack("<3h", params[1:7])
+        acc = struct.unpack("<3h", params[7:13])
+        standing.append((gyro, acc))
+    # walking upright: the board's z accelerometer near +1 g (16384 LSB), gyro within +-100 deg/s (1640 LSB)
+    accs_z = [a[2] for _, a in standing]
+    assert 0.9 * 16384 < sum(accs_z) / len(accs_z) < 1.1 * 16384
+    assert all(abs(g) < 1640 for gyro, _ in standing for g in gyro)
+    assert run_cli(capsys, "check", record)[0] == 0
+
+
+def test_a_fall_is_noticed_within_100_ms_and_the_walk_stops_with_exit_1(tmp_path, capsys):
+    record = tmp_path / "fall.jsonl"
+    code, out, err = run_cli(capsys, "walk", "--sim", "--json", "--robot", "op3", "--distance", "0.6", "--push", "3",
+                             "--feedback", "gyro", "--record", record)
+    assert code == 1, err
+    report = json.loads(out)
+    fall = report["fall_noticed"]
+    assert fall["direction"] == "sideways (left)"  # pushed to the left
+    assert 0 <= fall["t_s"] - fall["true_tilt_crossed_s"] <= 0.1
+    assert report["outcome"] == "fell"
+    assert run_cli(capsys, "check", record)[0] == 0  # the goals up to the fall and the fall stop obey every limit
+    code, out, err = run_cli(capsys, "walk", "--sim", "--robot", "op3", "--distance", "0.6", "--push", "3")
+    assert code == 1
+    assert "The robot fell sideways (left) at" in out and "noticed by the IMU" in out
+
+
+@pytest.mark.parametrize("fault, words", [("frozen", "frozen"), ("noisy", "noisy"), ("absent", "absent")])
+def test_a_broken_imu_is_said_once_and_the_walk_goes_on_open_loop(fault, words, capsys):
+    code, out, err = run_cli(capsys, "walk", "--sim", "--robot", "op3", "--distance", "0.4", "--imu-fault", fault)
+    assert code == 0, err
+    warnings = [line for line in err.splitlines() if line.startswith("warning: IMU")]
+    assert len(warnings) == 1 and words in warnings[0] and "walking open loop" in warnings[0]
+
+
+def test_a_robot_without_an_imu_says_so_once_and_refuses_feedback(capsys):
+    code, out, err = run_cli(capsys, "walk", "--dry-run", "--robot", "xl430-biped", "--distance", "0.2")
+    assert code == 0
+    assert err.count("has no IMU") == 1
+    code, out, err = run_cli(capsys, "walk", "--dry-run", "--robot", "xl430-biped", "--distance", "0.2",
+                             "--feedback", "gyro")
+    assert code == 2 and "--feedback gyro: robot xl430-biped has no IMU" in err
