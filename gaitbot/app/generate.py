@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gaitbot.app.options import UsageError, check_output_path, walked_by, write_output
+from gaitbot.app.options import UsageError, walked_by
+from gaitbot.app.outputs import output_path, write_output
 from gaitbot.app.walks import trajectory_for_robot
 
 
@@ -17,7 +18,7 @@ def run(args) -> int:
     out = Path(args.output)
     if out.suffix not in (".csv", ".npz"):
         raise UsageError(f"-o {out}: the output must end in .csv or .npz")
-    check_output_path(out)
+    output_path(out, "-o", args)
     source, walker, trajectory = trajectory_for_robot(args, goals=getattr(args, "goals", False))
     write_output(out, trajectory.save)
     print(f"wrote {out} for {walked_by(source)}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "

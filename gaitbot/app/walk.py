@@ -10,7 +10,8 @@ import math
 import sys
 
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
-from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
+from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, load_robot
+from gaitbot.app.outputs import output_path
 from gaitbot.app.progress import callback, progress
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.bus.factory import guarded, make_robot_bus
@@ -88,7 +89,7 @@ def run(args) -> int:
         warn_about_latency(port)
     recorder = None
     if args.record is not None:
-        file_option(args.record, "--record")
+        output_path(args.record, "--record", args)
         joints = {j.name: j.id for j in config.joints}
         recorder = BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now,
                                rate_hz=source.settings.rate_hz)
