@@ -37,7 +37,7 @@ from gaitbot.gait.walker import WalkSettings, make_context
 from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
 from gaitbot.robot.gains import GainError, gain_for_error
 from gaitbot.robot.health import HealthSettings, read_health
-from gaitbot.servos import BACKENDS, dynamixel, feetech, max_servo_id, vendor
+from gaitbot.servos import BACKENDS, baud_rates, dynamixel, feetech, max_servo_id, vendor
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
 
 DEFAULT_ROBOT = "xl430-biped"
@@ -369,7 +369,7 @@ class _Reader(Fields):
         bus = self.bus(self.table(data, "bus", "bus", _BUS_KEYS))
         joints = self.joints(data, bus)
         boom = self.boolean(robot, "boom", "robot", default=False)
-        links = self.links(data) if "links" in data else None
+        links = self.links(data, geometry) if "links" in data else None
         mass = self.mass(self.optional_table(data, "mass", "mass", _MASS_KEYS), links)
         servo = self.servo(self.optional_table(data, "servo", "servo", _SERVO_KEYS))
         self.gains_settable(joints, servo)
@@ -430,21 +430,39 @@ class _Reader(Fields):
                                                  f"= {mass.total_kg:.6f} kg")
         return mass
 
-    def links(self, data: dict) -> tuple[tuple[str, LinkInertial], ...]:
-        """``[links.<name>]``: mass, centre of mass and inertia of the torso and the left leg's six links."""
+    def links(self, data: dict, geometry: Geometry) -> tuple[tuple[str, LinkInertial], ...]:
+        """``[links.<name>]``: mass, centre of mass and inertia of the torso and the left leg's six links.
+
+        Physical ranges: a link's centre of mass lies within the robot's reach of its joint (the leg, thigh +
+        shank + foot: no link of a biped is larger), and its inertia is a rigid body's: principal moments
+        positive (zero for a massless link), none larger than the other two together, and none larger than
+        mass x reach^2 (all of a link's mass within the reach of its centre)."""
         tables = self.table(data, "links", "links", _LINK_NAMES)
+        reach_m = geometry.thigh_m + geometry.shank_m + geometry.foot_m
         out = []
         for name in _LINK_NAMES:
             f = f"links.{name}"
             t = self.table(tables, name, f, _LINK_KEYS)
             mass = self.number(t, "mass_kg", f, positive=name == "torso", non_negative=True, within=MASS_RANGE_KG)
             com = self.vector(t, "com_m", f, 3, "[x, y, z] in metres")
-            inertia = inertia_matrix(*self.vector(t, "inertia_kg_m2", f, 6, "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] in kg m^2"))
+            distance_m = math.sqrt(sum(c * c for c in com)) if all(abs(c) < 1e100 for c in com) else math.inf
+            if distance_m > reach_m:
+                raise self.fail(f"{f}.com_m", f"{distance_m:.3g} m from the link's joint, beyond the robot's reach "
+                                              f"(thigh_m + shank_m + foot_m = {reach_m:g} m)")
+            values = self.vector(t, "inertia_kg_m2", f, 6, "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] in kg m^2")
+            largest = mass * reach_m ** 2
+            for i, value in enumerate(values):
+                if not abs(value) <= largest:
+                    raise self.fail(f"{f}.inertia_kg_m2[{i}]", f"{value:g} kg m^2 is more than a {mass:g} kg link within "
+                                                               f"the robot's reach can have (mass_kg x {reach_m:g}^2 = "
+                                                               f"{largest:.3g} kg m^2)")
+            inertia = inertia_matrix(*values)
             moments = np.linalg.eigvalsh(inertia)
             scale = max(float(moments.max()), 1e-12)
-            if moments.min() < -1e-9 * scale or moments.max() > moments.sum() - moments.max() + 1e-9 * scale:
+            positive = moments.min() > 0 if mass > 0 else moments.min() >= -1e-9 * scale
+            if not positive or moments.max() > moments.sum() - moments.max() + 1e-9 * scale:
                 raise self.fail(f"{f}.inertia_kg_m2", "is not the inertia of a rigid body (its principal moments "
-                                                      f"{', '.join(f'{m:.3g}' for m in moments)} must be >= 0 and "
+                                                      f"{', '.join(f'{m:.3g}' for m in moments)} must be > 0 and "
                                                       "none larger than the other two together)")
             out.append((name, LinkInertial(mass, np.array(com), inertia)))
         return tuple(out)
@@ -616,6 +634,11 @@ class _Reader(Fields):
             spoken = ", ".join(str(p) for p in model.protocols)
             raise self.fail("bus.protocol", f"{model_name} ({f}) does not speak protocol {bus.protocol} "
                                             f"(it speaks {spoken})")
+
+        rates = sorted(set(baud_rates(model_name).values()), reverse=True)
+        if bus.baudrate not in rates:  # the model's Baud Rate register (ROBOTIS e-Manual, Feetech's memory table)
+            raise self.fail("bus.baudrate", f"{bus.baudrate} is not a baud rate the {model_name} ({f}) can be set to "
+                                            f"(its Baud Rate register allows: {', '.join(map(str, rates))})")
 
         max_id = max_servo_id(bus.backend, bus.protocol)
         servo_id = self.integer(t, "id", f, f"an integer servo id 0..{max_id}")

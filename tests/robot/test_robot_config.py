@@ -432,7 +432,7 @@ def test_config_module_does_not_import_the_bus_room():
 def test_shipped_configs_fit_the_bus_frame_budget_through_the_hook(tmp_path, name):
     """The wiring the CLI is expected to use: the bus room's rate check, adapted to a ConfigError,
     passed as an extra check. Every shipped robot must carry 60 Hz with read-back at 1 Mbaud,
-    and none can at 9600 baud (8 servos x ~14 bytes x 10 bits > 0.7 x 16.7 ms)."""
+    and none can at 57600 baud (8 servos x ~14 bytes x 10 bits > 0.7 x 16.7 ms), a rate every model can be set to."""
     budget = pytest.importorskip("gaitbot.bus.budget")
 
     def bus_can_carry_rate(config: RobotConfig) -> None:
@@ -443,7 +443,7 @@ def test_shipped_configs_fit_the_bus_frame_budget_through_the_hook(tmp_path, nam
             raise ConfigError(config.path, "gait.rate_hz", str(exc)) from None
 
     load_robot_config(resolve_config(name), extra_checks=[bus_can_carry_rate])
-    slow = shipped_text(name).replace("baudrate = 1000000", "baudrate = 9600")
+    slow = shipped_text(name).replace("baudrate = 1000000", "baudrate = 57600")
     with pytest.raises(ConfigError, match="gait.rate_hz"):
         path = tmp_path / "slow.toml"
         path.write_text(slow)
