@@ -366,9 +366,10 @@ def _npz_joint_names(path: Path, arrays: dict, version: int) -> tuple[str, ...]:
 
 def load_fast(path: str | Path) -> Trajectory:
     """Trajectory.load, with a fast path for plain CSV files as ``generate`` writes them (numpy's C
-    reader: a one-hour file in a fraction of a second instead of over one). Anything the fast path
-    does not take as it is -- another header, a bad cell, a non-finite or non-increasing time -- goes
-    to Trajectory.load, whose one-line errors name the problem."""
+    reader: a one-hour file in a fraction of a second instead of over one). The fast path's table goes
+    through the same checks and bounds as Trajectory.load's (``_from_table``: finite, MAX_TIME_S,
+    MAX_ANGLE_DEG, MAX_ROOT_M, increasing times), so ``check`` and ``walk`` refuse the same files the same
+    way; anything it does not parse (another header, a bad cell) goes to Trajectory.load."""
     path = Path(path)
     if path.suffix == ".csv" and path.is_file():
         try:
@@ -381,10 +382,11 @@ def load_fast(path: str | Path) -> Trajectory:
                             and header == list(("t_s",) + tuple(f"{n}_deg" for n in joints) + ROOT_COLUMNS)):
                         table = np.loadtxt(f, delimiter=",", ndmin=2, dtype=float)
                         j = len(joints)
-                        if (table.shape[1] == len(header) and len(table) >= 2 and np.all(np.isfinite(table))
-                                and np.all(np.diff(table[:, 0]) > 0)):
-                            return Trajectory(table[:, 0].copy(), np.radians(table[:, 1:1 + j]),
-                                              table[:, 1 + j:4 + j].copy(), joints=joints)
+                        if table.shape[1] == len(header):  # the same checks and bounds as Trajectory.load
+                            return _from_table(path, table[:, 0].copy(), table[:, 1:1 + j],
+                                               table[:, 1 + j:4 + j].copy(), joints=joints)
+        except TrajectoryFileError:
+            raise
         except (OSError, UnicodeDecodeError, ValueError):
             pass
     return Trajectory.load(path)
