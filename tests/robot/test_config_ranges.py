@@ -65,3 +65,16 @@ def test_the_command_line_refuses_them_in_one_line_exit_2(tmp_path):
     proc = gaitbot("walk", "--dry-run", "--robot", str(path), "--distance", "0.1")
     assert proc.returncode == 2 and "links.torso.com_m" in proc.stderr
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+
+
+def test_each_tables_keys_are_its_data_class_fields_and_the_module_is_short():
+    """Issue 21: the allowed keys were tuples kept by hand beside the fields; now derived, written once."""
+    from dataclasses import fields
+
+    from gaitbot.robot import config as module
+    from gaitbot.robot.config_types import GaitSettings, Geometry, JointConfig
+
+    assert module._GEOMETRY_KEYS == tuple(f.name for f in fields(Geometry))
+    assert module._GAIT_KEYS == tuple(f.name for f in fields(GaitSettings))
+    assert set(module._JOINT_KEYS) == {f.name for f in fields(JointConfig)} - {"name"}
+    assert len(open(module.__file__).read().splitlines()) < 600
