@@ -142,6 +142,7 @@ class Trajectory:
         path = Path(path)
         if not path.exists():
             raise TrajectoryFileError(f"{path}: no such file")
+        _refuse_too_large(path)
         if path.suffix == ".npz":
             return _load_npz(path)
         if path.suffix == ".csv":
@@ -153,6 +154,11 @@ def sagittal_to_world(root_xz_m: np.ndarray) -> np.ndarray:
     """(N, 2) sagittal-plane points (forward, up) -> (N, 3) world points (x, y = 0, z)."""
     return np.column_stack([root_xz_m[:, 0], np.zeros(len(root_xz_m)), root_xz_m[:, 1]])
 
+
+#: The largest trajectory file (CSV or NPZ) gaitbot reads: what ``gaitbot check`` checks within a minute on
+#: two cores, the 12 joints and the balance of op3 included (2.8 MB/s on a loaded 2-core machine: 46 s;
+#: ``python tools/bench_check.py --robot op3``). Other files keep gaitbot.fields.MAX_FILE_BYTES.
+MAX_TRAJECTORY_BYTES = 128 * 2**20
 
 #: Values a trajectory file may hold (far beyond any walk; beyond them arithmetic on them overflows).
 MAX_TIME_S = 1e7
@@ -371,6 +377,7 @@ def load_fast(path: str | Path) -> Trajectory:
     MAX_ANGLE_DEG, MAX_ROOT_M, increasing times), so ``check`` and ``walk`` refuse the same files the same
     way; anything it does not parse (another header, a bad cell) goes to Trajectory.load."""
     path = Path(path)
+    _refuse_too_large(path)
     if path.suffix == ".csv" and path.is_file():
         try:
             with open(path, encoding="utf-8") as f:
@@ -390,6 +397,17 @@ def load_fast(path: str | Path) -> Trajectory:
         except (OSError, UnicodeDecodeError, ValueError):
             pass
     return Trajectory.load(path)
+
+
+def _refuse_too_large(path: Path) -> None:
+    """A trajectory file over MAX_TRAJECTORY_BYTES is refused before it is read (one line, exit 2)."""
+    try:
+        size = path.stat().st_size if path.is_file() else 0
+    except OSError:
+        return  # the reader says what is wrong with it
+    if size > MAX_TRAJECTORY_BYTES:
+        raise TrajectoryFileError(f"{path}: {size / 2**20:.0f} MB, more than the {MAX_TRAJECTORY_BYTES // 2**20} MB a "
+                                  f"trajectory file may have (what gaitbot check checks within a minute)")
 
 
 def refuse_truncated_csv(path: str | Path) -> None:

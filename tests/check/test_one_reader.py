@@ -34,3 +34,17 @@ def test_check_and_walk_refuse_the_same_file_the_same_way(walk_csv, tmp_path, co
     reason = checked.stderr.strip().split(": ", 1)[1]  # after "gaitbot check"
     assert reason == walked.stderr.strip().split(": ", 1)[1], (checked.stderr, walked.stderr)
     assert f"{bound:g}" in reason
+
+
+def test_a_trajectory_over_the_checkable_size_is_refused_before_it_is_read(tmp_path):
+    """Issue 26 item 9: the limit is what check reads within a minute (tools/bench_check.py), not 256 MB."""
+    from gaitbot.gait.trajectory import MAX_TRAJECTORY_BYTES
+
+    big = tmp_path / "big.csv"
+    with open(big, "wb") as f:
+        f.seek(MAX_TRAJECTORY_BYTES)
+        f.write(b"\n")  # sparse: no disk, and nothing of it is read
+    for argv in (["check", str(big)], ["walk", "--dry-run", "--trajectory", str(big)]):
+        proc = gaitbot(*argv)
+        assert proc.returncode == 2 and "128 MB" in proc.stderr, proc.stderr
+        assert len(proc.stderr.strip().splitlines()) == 1
