@@ -387,8 +387,8 @@ class _Reader(Fields):
 
         rates = sorted(set(baud_rates(model_name).values()), reverse=True)
         if bus.baudrate not in rates:  # the model's Baud Rate register (ROBOTIS e-Manual, Feetech's memory table)
-            raise self.fail("bus.baudrate", f"{bus.baudrate} is not a baud rate the {model_name} ({f}) can be set to "
-                                            f"(its Baud Rate register allows: {', '.join(map(str, rates))})")
+            raise self.fail("bus.baudrate", f"a {model_name} ({name}) cannot run at {bus.baudrate:,} baud (its Baud "
+                                            f"Rate register allows: {', '.join(map(str, rates))})")
 
         max_id = max_servo_id(bus.backend, bus.protocol)
         servo_id = self.integer(t, "id", f, f"an integer servo id 0..{max_id}")

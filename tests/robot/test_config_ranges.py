@@ -56,7 +56,7 @@ def test_a_baud_rate_the_servo_model_cannot_be_set_to_is_refused(tmp_path):
     assert re.search(r"^baudrate = 1000000", bioloid, re.M)
     message = refused(tmp_path, re.sub(r"^baudrate = 1000000", "baudrate = 2000000", bioloid, flags=re.M),
                       "bus.baudrate")
-    assert "AX-12A" in message and "1000000" in message
+    assert "AX-12A" in message and "cannot run at 2,000,000 baud" in message and "1000000" in message
 
 
 def test_the_command_line_refuses_them_in_one_line_exit_2(tmp_path):
