@@ -1,92 +1,63 @@
-#!/usr/bin/env python3
-"""Benchmark of ``gaitbot check``: a one-hour 60 Hz trajectory, and a dry-run recording.
+"""How fast ``gaitbot check`` reads and checks a trajectory CSV: the figure behind the file size limit.
 
-Prints figures (best of a few runs), no pass/fail: the README quotes them with the machine.
-The hour is a real ``generate`` walk (1 m, starting and ending standing) repeated end to end, so
-it is continuous and as busy as walking; it is checked three ways: ``check_trajectory`` on
-arrays, and the whole ``gaitbot check`` path (file load + check + report) from .npz and from .csv.
+    python tools/bench_check.py            # a 32 MB file (about 400,000 rows), timed, and the 256 MB limit
+    python tools/bench_check.py --mb 256   # the largest file gaitbot reads (gaitbot.fields.MAX_FILE_BYTES)
+    python tools/bench_check.py --mb 8 --robot op3   # a robot whose balance is checked too
 
-    python tools/bench_check.py [--robot xl430-biped] [--repeat 3]
+Writes a valid walk-shaped CSV of the given size (the generate format: t_s, six joint angles, the root) in a
+temporary folder, then runs ``gaitbot check`` on it in this process and prints the seconds, the rate in MB/s
+and what that rate makes of the largest allowed file (issue 26 item 9: it must be checked within a minute).
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
-import io
-import platform
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-
-def best_of(repeat: int, fn) -> float:
-    best = float("inf")
-    for _ in range(repeat):
-        start = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - start)
-    return best
+from gaitbot.app.cli import main as gaitbot
+from gaitbot.fields import MAX_FILE_BYTES
+from gaitbot.gait.trajectory import VERSION_LINE
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--robot", default="xl430-biped")
-    parser.add_argument("--repeat", type=int, default=3)
+def write_csv(path: Path, megabytes: float) -> int:
+    """A slow sway within every limit of the default robot, ``megabytes`` MB; returns its rows."""
+    header = "t_s,hip_pitch_left_deg,knee_pitch_left_deg,ankle_pitch_left_deg,hip_pitch_right_deg," \
+             "knee_pitch_right_deg,ankle_pitch_right_deg,root_x_m,root_y_m,root_z_m"
+    rows, chunk = 0, 100_000
+    with open(path, "w") as f:
+        f.write(f"{VERSION_LINE}\n{header}\n")
+        while f.tell() < megabytes * 2**20:
+            k = np.arange(rows, rows + chunk)
+            t = k / 60.0
+            sway = 5.0 * np.sin(2 * np.pi * 0.2 * t)
+            table = np.column_stack([t, 10 + sway, 20 + sway, 10 + sway, 10 - sway, 20 - sway, 10 - sway,
+                                     0.001 * sway, 0 * t, 0.3 + 0 * t])
+            np.savetxt(f, table, fmt="%.9g", delimiter=",")
+            rows += chunk
+    return rows
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--mb", type=float, default=32.0, help="file size in MB (default 32)")
+    parser.add_argument("--robot", default="xl430-biped", help="the robot checked against (op3: its balance too)")
     args = parser.parse_args(argv)
-
-    from gaitbot.check.trajectory import check_trajectory, trajectory_angles_deg
-    from gaitbot.check.recording import check_recording
-    from gaitbot.app.cli import main as gaitbot
-    from gaitbot.gait.trajectory import Trajectory
-    from gaitbot.app.options import load_robot
-
-    config = load_robot(args.robot)
-    quiet = contextlib.redirect_stdout(io.StringIO())
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        with quiet:
-            gaitbot(["generate", "--distance", "1", "--robot", args.robot, "-o", str(tmp / "walk.npz")])
-            gaitbot(["walk", "--dry-run", "--distance", "1", "--robot", args.robot, "--record", str(tmp / "run.jsonl")])
-        walk = Trajectory.load(tmp / "walk.npz")
-        rate = 60.0
-        n_hour = int(3600 * rate) + 1
-        reps = -(-n_hour // (len(walk) - 1))
-        angles = np.concatenate([walk.angles_rad[:-1]] * reps + [walk.angles_rad[-1:]])[:n_hour]
-        t = np.arange(n_hour) / rate
-        hour = Trajectory(t, angles, np.zeros((n_hour, 2)))
-        hour.save(tmp / "hour.npz")
-        hour.save(tmp / "hour.csv")
-        degrees = trajectory_angles_deg(config, hour.angles_rad)
-
-        report = check_trajectory(config, t, degrees)
-        assert report.ok, report.first_error
-        arrays_s = best_of(args.repeat, lambda: check_trajectory(config, t, degrees))
-
-        def cli(path):
-            with contextlib.redirect_stdout(io.StringIO()):
-                code = gaitbot(["check", str(path), "--robot", args.robot])
-            assert code == 0, f"check {path} exited {code}"
-
-        npz_s = best_of(args.repeat, lambda: cli(tmp / "hour.npz"))
-        csv_s = best_of(args.repeat, lambda: cli(tmp / "hour.csv"))
-        rec = check_recording(config, tmp / "run.jsonl")
-        rec_s = best_of(args.repeat, lambda: check_recording(config, tmp / "run.jsonl"))
-
-    print(f"bench_check on {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
-          f"numpy {np.__version__}, robot {args.robot}, best of {args.repeat}")
-    print(f"  one hour at 60 Hz ({n_hour} frames x {len(config.joints)} joints):")
-    print(f"    check_trajectory on arrays        {arrays_s * 1000:8.1f} ms")
-    print(f"    gaitbot check hour.npz (load+check) {npz_s * 1000:6.1f} ms")
-    print(f"    gaitbot check hour.csv (load+check) {csv_s * 1000:6.1f} ms")
-    print(f"  dry-run recording ({rec.n_packets} packets, {rec.n_goal_frames} goal frames, "
-          f"{rec.n_goal_frames / rate:.1f} s of walk): check_recording {rec_s * 1000:.1f} ms "
-          f"({rec_s / (rec.n_goal_frames / rate) * 3600:.2f} s per recorded hour)")
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "big.csv"
+        rows = write_csv(path, args.mb)
+        size_mb = path.stat().st_size / 2**20
+        start = time.perf_counter()
+        status = gaitbot(["check", str(path), "--robot", args.robot, "--json"])
+        elapsed_s = time.perf_counter() - start
+    rate = size_mb / elapsed_s
+    limit_mb = MAX_FILE_BYTES / 2**20
+    print(f"gaitbot check --robot {args.robot} of a {size_mb:.0f} MB CSV ({rows} rows): {elapsed_s:.1f} s, {rate:.1f} MB/s, exit {status}; "
+          f"the largest allowed file ({limit_mb:.0f} MB) at this rate: {limit_mb / rate:.0f} s", file=sys.stderr)
     return 0
 
 

@@ -8,7 +8,8 @@ Every figure is a ``gaitbot walk --sim --json`` run through the command line its
 OP3_WALKS and the bioloid's of BIOLOID_WALKS (issue 15's targets); per pitch-only robot, 1 m with the
 pitch held and with it free; the same walks with the ankle at the heel (``heel_back_m = 0``), at the servos'
 factory gains (no ``[servo] full_torque_error_deg``), and both; and toe drag (``--clearance 0``) at factory
-and at the shipped gains. The simulation is deterministic: a run gives the same figures on every machine.
+and at the shipped gains. The simulation is deterministic on one machine; another CPU or MuJoCo release moves the figures within
+the simulated figures' tolerance (docs/figures.md, "Simulated figures").
 """
 
 from __future__ import annotations

@@ -9,13 +9,13 @@ range. Nothing is written to a servo but Torque Enable = 0.
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
 from gaitbot.app.arguments import REPLY_TIMEOUT_HELP, add_command
 from gaitbot.app.hardware import serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
+from gaitbot.app.outputs import output_path, write_output
 from gaitbot.bus.factory import make_robot_bus
 from gaitbot.robot.calibration_file import (CalibrationFile, JointCalibration, apply_calibration,
                                             calibration_path_for, write_calibration)
@@ -32,9 +32,6 @@ def _check_output(out: Path) -> None:
     if out.suffix != ".toml":
         raise UsageError(f"-o {out}: a calibration file is TOML: the name must end in .toml "
                          f"(e.g. {calibration_path_for('robot.toml').name}, found beside robot.toml by name)")
-    parent = out.parent if str(out.parent) else Path(".")
-    if out.is_dir() or not parent.is_dir() or not os.access(parent, os.W_OK):
-        raise UsageError(f"-o {out}: cannot write there (no such directory, or no permission)")
 
 
 def _wait_for_enter(step: str, words: str) -> None:
@@ -70,6 +67,7 @@ def run(args) -> int:
     config = load_robot(args.robot, None)  # measured as the config describes the servos, without any calibration
     out = Path(args.output)
     _check_output(out)
+    output_path(out, "-o", args)
     check_reply_timeout(args.reply_timeout_ms)
     port = serial_port(config, args.port, dry_run=False)
     warn_about_latency(port)
@@ -82,10 +80,10 @@ def run(args) -> int:
     calibrated = [JointCalibration(r.name, r.id, r.model_name, r.zero_tick, r.direction, round(r.moved_deg, 1))
                   for r in results]
     apply_calibration(config, CalibrationFile(out, config.name, tuple(calibrated)))  # refuses what cannot hold
-    write_calibration(out, config.name, calibrated,
-                      comment=f"gaitbot calibrate --robot {config.path}: zero ticks and directions of {config.name}'s "
-                              "servos,\nmeasured on the robot (docs/file-formats.md). Applied on top of the config by "
-                              "--calibration,\nor found beside the config as <config stem>.calibration.toml.")
+    comment = (f"gaitbot calibrate --robot {config.path}: zero ticks and directions of {config.name}'s servos,\n"
+               "measured on the robot (docs/file-formats.md). Applied on top of the config by --calibration,\n"
+               "or found beside the config as <config stem>.calibration.toml.")
+    write_output(out, lambda path: write_calibration(path, config.name, calibrated, comment=comment))
     print(f"{'joint':20s} {'id':>4s} {'zero tick':>9s} {'direction':>9s} {'bent deg':>8s}  was (config)")
     by_name = {j.name: j for j in config.joints}
     for r in results:

@@ -34,7 +34,8 @@ from gaitbot.gait.eigen import (EigenGaitModel, EigenModelError, FitOptions, Pla
                                 cycles_from_trajectory, fit_model, synthesize_walk, walk_label)
 from gaitbot.gait.footfall import CONTACT_TOL_FRACTION
 from gaitbot.gait.trajectory import MAX_ANGLE_DEG, Trajectory
-from gaitbot.app.options import UsageError, check_output_path, gait_source, load_robot, write_output
+from gaitbot.app.options import UsageError, gait_source, load_robot
+from gaitbot.app.outputs import output_path, write_output
 from gaitbot.app.progress import callback, progress
 from gaitbot.app.planned_walk import balanced_plan
 from gaitbot.check.preflight import preflight
@@ -196,7 +197,7 @@ def run_fit(args) -> int:
     out = Path(args.output)
     if out.suffix != ".npz":
         raise UsageError(f"-o {out}: the model file must end in .npz")
-    check_output_path(out)
+    output_path(out, "-o", args)
     source = gait_source(args)
     config = load_robot(args.robot, getattr(args, "calibration", None))
     refuse_leg_options_for_3d(args, config)
@@ -357,7 +358,7 @@ def run_synth(args) -> int:
     out = Path(args.output)
     if out.suffix not in (".csv", ".npz"):
         raise UsageError(f"-o {out}: the output must end in .csv or .npz")
-    check_output_path(out)
+    output_path(out, "-o", args)
     if not 1 <= args.cycles <= MAX_CYCLES:
         raise UsageError(f"--cycles must be 1..{MAX_CYCLES}, got {args.cycles}")
     if args.pose_time is not None and args.pose_deg is None:

@@ -10,7 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from gaitbot.app.arguments import add_command, check_walk_source, walk_options
-from gaitbot.app.options import UsageError, check_output_path, walked_by, write_output
+from gaitbot.app.options import UsageError, walked_by
+from gaitbot.app.outputs import output_path, write_output
 from gaitbot.app.planned_walk import planned_walk
 
 
@@ -31,7 +32,7 @@ def run(args) -> int:
     out = Path(args.output)
     if out.suffix not in (".csv", ".npz"):
         raise UsageError(f"-o {out}: the output must end in .csv or .npz")
-    check_output_path(out)
+    output_path(out, "-o", args)
     walk = planned_walk(args)
     trajectory = walk.goals if getattr(args, "goals", False) else walk.planned
     write_output(out, trajectory.save)

@@ -8,8 +8,6 @@ once, the leg and walk settings (``gait_source``) and the step list. Errors for 
 from __future__ import annotations
 
 import math
-import os
-from pathlib import Path
 
 from gaitbot.errors import UserError
 from gaitbot.gait.geometry import LegGeometry
@@ -47,26 +45,6 @@ def file_option(value: str, flag: str) -> str:
     if value is None or not str(value).strip():
         raise UsageError(f"{flag}: empty file name")
     return value
-
-
-def check_output_path(out: Path, flag: str = "-o") -> None:
-    """An output file that can be written before any work is done: not a directory, in a folder that exists
-    and is writable (a device such as /dev/full is only found out when written: see ``write_output``)."""
-    if out.is_dir():
-        raise UsageError(f"{flag} {out}: is a directory")
-    parent = out.parent if str(out.parent) else Path(".")
-    if not parent.is_dir():
-        raise UsageError(f"{flag} {out}: cannot write there (no such directory {parent})")
-    if not os.access(parent, os.W_OK) or (out.exists() and not os.access(out, os.W_OK)):
-        raise UsageError(f"{flag} {out}: cannot write there (no permission)")
-
-
-def write_output(out: Path, write, flag: str = "-o") -> None:
-    """``write(out)``, with a failure to write (a full disk, /dev/full, a vanished folder) as one line, exit 2."""
-    try:
-        write(out)
-    except OSError as exc:
-        raise UsageError(f"{flag} {out}: cannot write ({exc.strerror or exc})") from None
 
 
 def positive_option(value: float | None, flag: str, what: str) -> None:

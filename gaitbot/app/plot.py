@@ -5,7 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from gaitbot.app.arguments import add_command, leg_options, robot_options
-from gaitbot.app.options import UsageError, check_output_path, file_option, gait_source, walked_by, write_output
+from gaitbot.app.options import UsageError, file_option, gait_source, walked_by
+from gaitbot.app.outputs import output_path, write_output
 from gaitbot.errors import UserError
 from gaitbot.gait.eigen import is_model_file
 from gaitbot.gait.terrain.course_file import load_course
@@ -33,8 +34,7 @@ def run(args) -> int:
         raise UsageError("plotting needs matplotlib: pip install 'gaitbot[plot]'") from None
     from gaitbot.plot import plot_eigen_model, plot_trajectory
 
-    out = Path(args.output)
-    check_output_path(out)
+    out = output_path(args.output, "-o", args)
     from matplotlib.backend_bases import FigureCanvasBase
 
     formats = sorted(FigureCanvasBase.get_supported_filetypes())

@@ -16,7 +16,6 @@ refused in turn.
 from __future__ import annotations
 
 import math
-import os
 import sys
 from pathlib import Path
 
@@ -25,6 +24,7 @@ import numpy as np
 from gaitbot.app.arguments import add_command, bus_options, robot_options
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
+from gaitbot.app.outputs import output_path
 from gaitbot.bus.factory import make_robot_bus
 from gaitbot.gait.footfall import ContactRoot
 from gaitbot.gait.joints import PITCH_JOINTS
@@ -118,11 +118,6 @@ def _check_output(out: Path) -> None:
     if out.suffix != ".csv":
         raise UsageError(f"-o {out}: a recording is written as it is read, in the trajectory CSV format: "
                          f"the file must end in .csv")
-    if out.is_dir():
-        raise UsageError(f"-o {out}: is a directory")
-    parent = out.parent if str(out.parent) else Path(".")
-    if not parent.is_dir() or not os.access(parent, os.W_OK) or (out.exists() and not os.access(out, os.W_OK)):
-        raise UsageError(f"-o {out}: cannot write there (no such directory, or no permission)")
 
 
 #: The longest recording by hand one --duration may ask for (a day); without --duration: until Ctrl-C.
@@ -173,6 +168,7 @@ def run(args) -> int:
     config = load_robot(args.robot, getattr(args, "calibration", None))
     out = Path(args.output)
     _check_output(out)
+    output_path(out, "-o", args)
     rate_hz = config.gait.rate_hz
     if args.dry_run and args.duration is None:
         raise UsageError("--dry-run needs --duration (a dry run has no hand on the legs and no Ctrl-C to wait for)")

@@ -43,7 +43,8 @@ def run(args) -> int:
 
 
 def export(args) -> int:
-    from gaitbot.app.options import UsageError, check_output_path, file_option, load_robot, write_output
+    from gaitbot.app.options import UsageError, file_option, load_robot
+    from gaitbot.app.outputs import output_path, write_output
     from gaitbot.robot.description.urdf_writer import urdf_text
     from gaitbot.sim.model3d import exported_mjcf
 
@@ -52,7 +53,7 @@ def export(args) -> int:
     outputs = [(flag, Path(file_option(value, flag)), make) for flag, value, make in
                (("--urdf", args.urdf, urdf_text), ("--mjcf", args.mjcf, exported_mjcf)) if value]
     for flag, out, _ in outputs:
-        check_output_path(out, flag)
+        output_path(out, flag, args)
     config = load_robot(args.robot)
     for flag, out, make in outputs:
         text = make(config)
@@ -64,7 +65,8 @@ def export(args) -> int:
 
 
 def import_description(args) -> int:
-    from gaitbot.app.options import UsageError, check_output_path, file_option, load_robot, write_output
+    from gaitbot.app.options import UsageError, file_option, load_robot
+    from gaitbot.app.outputs import output_path, write_output
     from gaitbot.robot.config import ConfigError, load_robot_config
     from gaitbot.robot.description.chains import leg_joints, mapping_text, read_map
     from gaitbot.robot.description.draft import draft_text
@@ -73,7 +75,7 @@ def import_description(args) -> int:
     from gaitbot.sim.description import read_description
 
     out = Path(file_option(args.output, "-o"))
-    check_output_path(out)
+    output_path(out, "-o", args)
     source = Path(file_option(args.description, "description"))
     like = load_robot(args.like) if args.like is not None else None
     mapping = read_map(file_option(args.map, "--map")) if args.map is not None else None

@@ -28,10 +28,11 @@ def host_port(text: str) -> tuple[str, int]:
 
 def mcap_path(text: str) -> str:
     """``--mcap FILE``: a file that can be written, checked before any work is done."""
-    from gaitbot.app.options import UsageError, check_output_path, file_option
+    from gaitbot.app.options import UsageError, file_option
+    from gaitbot.app.outputs import output_path
 
     try:
-        check_output_path(Path(file_option(text, "--mcap")), "--mcap")
+        output_path(Path(file_option(text, "--mcap")), "--mcap")
     except UsageError as exc:
         raise argparse.ArgumentTypeError(str(exc).removeprefix("--mcap: ").removeprefix("--mcap ")) from None
     except OSError as exc:  # a name the OS refuses (too long, a loop)

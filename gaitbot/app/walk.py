@@ -15,6 +15,7 @@ from gaitbot.app.feel_options import add_feedback_option, fall_dict, fall_line, 
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
 from gaitbot.app.planned_walk import PlannedWalk, planned_walk
+from gaitbot.app.outputs import output_path
 from gaitbot.app.progress import callback, progress
 from gaitbot.app.sim_options import add_sim_model_options, check_sim_model, foreign_model, parse_push
 from gaitbot.app.view_options import add_view_options, open_view
@@ -154,7 +155,7 @@ def _recorder(args, config, clock, rate_hz: float) -> BusRecorder | None:
     """The ``--record`` file's writer (its header is written when the bus opens), if asked."""
     if args.record is None:
         return None
-    file_option(args.record, "--record")
+    output_path(args.record, "--record", args)
     joints = {j.name: j.id for j in config.joints}
     return BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now, rate_hz=rate_hz)
 

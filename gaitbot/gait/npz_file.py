@@ -20,14 +20,47 @@ from gaitbot.fields import read_user_file
 MAX_ELEMENTS = 20_000_000
 #: Kinds of arrays a numeric field may be: booleans, integers, floats (no complex, strings, objects).
 NUMERIC_KINDS = "biuf"
+#: Kinds of arrays a file may hold at all: numbers, and text (joint names, a model's kind and robot).
+READABLE_KINDS = NUMERIC_KINDS + "U"
+#: Bytes one array may take once read: MAX_ELEMENTS float64s. Checked on the header, before any data is read.
+MAX_BYTES = MAX_ELEMENTS * 8
+#: The longest text one element may hold (a joint or robot name), in characters.
+MAX_TEXT_CHARS = 256
 
 
 class NpzProblem(ValueError):
     """One line: what is wrong with which array of the file."""
 
 
-def read_npz(path: str | Path) -> dict[str, np.ndarray]:
-    """Every array of the file, each checked for its size and kind before its data is read.
+_READ_ERRORS = (ValueError, EOFError, OSError, zipfile.BadZipFile, zipfile.LargeZipFile, TypeError, OverflowError,
+                MemoryError, UnicodeDecodeError, SyntaxError, RuntimeError)
+
+
+def _checked_header(archive: zipfile.ZipFile, member: zipfile.ZipInfo, key: str) -> None:
+    """The array's header (shape and dtype, no data): its kind readable, its size within MAX_BYTES."""
+    with archive.open(member) as f:
+        version = np.lib.format.read_magic(f)
+        if version == (1, 0):
+            shape, _fortran, dtype = np.lib.format.read_array_header_1_0(f)
+        else:
+            shape, _fortran, dtype = np.lib.format.read_array_header_2_0(f)
+    if dtype.hasobject:
+        raise NpzProblem(f"array {key!r} holds Python objects (pickles are not read)")
+    if dtype.kind not in READABLE_KINDS:
+        raise NpzProblem(f"array {key!r} holds {_kind(dtype)} ({dtype}); a trajectory or model holds numbers "
+                         f"and names")
+    if dtype.kind == "U" and dtype.itemsize > 4 * MAX_TEXT_CHARS:
+        raise NpzProblem(f"array {key!r} holds text of {dtype.itemsize // 4} characters an element, more than "
+                         f"the {MAX_TEXT_CHARS} a name may have")
+    count = int(np.prod(shape, dtype=object)) if shape else 1
+    if count > MAX_ELEMENTS or count * dtype.itemsize > MAX_BYTES:
+        raise NpzProblem(f"array {key!r} claims {count} elements of {dtype.itemsize} bytes, more than the "
+                         f"{MAX_ELEMENTS} elements or {MAX_BYTES // 2**20} MB such a file may hold")
+
+
+def read_npz(path: str | Path, only: tuple[str, ...] | None = None) -> dict[str, np.ndarray]:
+    """Every array of the file (or those named in ``only``), after every array's header was checked for
+    its kind and size, whatever its name: no data is read before all headers passed.
 
     Raises OSError (the file cannot be read: missing, a directory, a device) or NpzProblem."""
     import io
@@ -35,31 +68,27 @@ def read_npz(path: str | Path) -> dict[str, np.ndarray]:
     data = read_user_file(path)
     try:
         archive = zipfile.ZipFile(io.BytesIO(data))
-        names = archive.namelist()
+        members = archive.infolist()  # every member, a repeated name too
     except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError, OSError) as exc:
         raise NpzProblem(f"not a readable .npz (not a zip archive: {exc})") from None
-    arrays: dict[str, np.ndarray] = {}
-    for member in names:
-        key = member[:-4] if member.endswith(".npy") else member
+    keys = [(member, member.filename[:-4] if member.filename.endswith(".npy") else member.filename)
+            for member in members]
+    for member, key in keys:
         try:
-            with archive.open(member) as f:
-                version = np.lib.format.read_magic(f)
-                if version == (1, 0):
-                    shape, _fortran, dtype = np.lib.format.read_array_header_1_0(f)
-                else:
-                    shape, _fortran, dtype = np.lib.format.read_array_header_2_0(f)
-                if dtype.hasobject:
-                    raise NpzProblem(f"array {key!r} holds Python objects (pickles are not read)")
-                count = int(np.prod(shape, dtype=object)) if shape else 1
-                if count > MAX_ELEMENTS:
-                    raise NpzProblem(f"array {key!r} claims {count} elements, more than the {MAX_ELEMENTS} "
-                                     "such a file may hold")
-            with archive.open(member) as f:
-                arrays[key] = np.lib.format.read_array(f, allow_pickle=False)
+            _checked_header(archive, member, key)
         except NpzProblem:
             raise
-        except (ValueError, EOFError, OSError, zipfile.BadZipFile, zipfile.LargeZipFile, TypeError,
-                OverflowError, MemoryError, UnicodeDecodeError, SyntaxError, RuntimeError) as exc:
+        except _READ_ERRORS as exc:
+            reason = " ".join(str(exc).split())[:200]
+            raise NpzProblem(f"array {key!r} is not readable ({type(exc).__name__}: {reason})") from None
+    arrays: dict[str, np.ndarray] = {}
+    for member, key in keys:
+        if only is not None and key not in only:
+            continue
+        try:
+            with archive.open(member) as f:
+                arrays[key] = np.lib.format.read_array(f, allow_pickle=False)
+        except _READ_ERRORS as exc:
             reason = " ".join(str(exc).split())[:200]
             raise NpzProblem(f"array {key!r} is not readable ({type(exc).__name__}: {reason})") from None
     return arrays

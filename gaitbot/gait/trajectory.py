@@ -142,6 +142,7 @@ class Trajectory:
         path = Path(path)
         if not path.exists():
             raise TrajectoryFileError(f"{path}: no such file")
+        _refuse_too_large(path)
         if path.suffix == ".npz":
             return _load_npz(path)
         if path.suffix == ".csv":
@@ -153,6 +154,11 @@ def sagittal_to_world(root_xz_m: np.ndarray) -> np.ndarray:
     """(N, 2) sagittal-plane points (forward, up) -> (N, 3) world points (x, y = 0, z)."""
     return np.column_stack([root_xz_m[:, 0], np.zeros(len(root_xz_m)), root_xz_m[:, 1]])
 
+
+#: The largest trajectory file (CSV or NPZ) gaitbot reads: what ``gaitbot check`` checks within a minute on
+#: two cores, the 12 joints and the balance of op3 included (2.8 MB/s on a loaded 2-core machine: 46 s;
+#: ``python tools/bench_check.py --robot op3``). Other files keep gaitbot.fields.MAX_FILE_BYTES.
+MAX_TRAJECTORY_BYTES = 128 * 2**20
 
 #: Values a trajectory file may hold (far beyond any walk; beyond them arithmetic on them overflows).
 MAX_TIME_S = 1e7
@@ -366,10 +372,12 @@ def _npz_joint_names(path: Path, arrays: dict, version: int) -> tuple[str, ...]:
 
 def load_fast(path: str | Path) -> Trajectory:
     """Trajectory.load, with a fast path for plain CSV files as ``generate`` writes them (numpy's C
-    reader: a one-hour file in a fraction of a second instead of over one). Anything the fast path
-    does not take as it is -- another header, a bad cell, a non-finite or non-increasing time -- goes
-    to Trajectory.load, whose one-line errors name the problem."""
+    reader: a one-hour file in a fraction of a second instead of over one). The fast path's table goes
+    through the same checks and bounds as Trajectory.load's (``_from_table``: finite, MAX_TIME_S,
+    MAX_ANGLE_DEG, MAX_ROOT_M, increasing times), so ``check`` and ``walk`` refuse the same files the same
+    way; anything it does not parse (another header, a bad cell) goes to Trajectory.load."""
     path = Path(path)
+    _refuse_too_large(path)
     if path.suffix == ".csv" and path.is_file():
         try:
             with open(path, encoding="utf-8") as f:
@@ -381,13 +389,25 @@ def load_fast(path: str | Path) -> Trajectory:
                             and header == list(("t_s",) + tuple(f"{n}_deg" for n in joints) + ROOT_COLUMNS)):
                         table = np.loadtxt(f, delimiter=",", ndmin=2, dtype=float)
                         j = len(joints)
-                        if (table.shape[1] == len(header) and len(table) >= 2 and np.all(np.isfinite(table))
-                                and np.all(np.diff(table[:, 0]) > 0)):
-                            return Trajectory(table[:, 0].copy(), np.radians(table[:, 1:1 + j]),
-                                              table[:, 1 + j:4 + j].copy(), joints=joints)
+                        if table.shape[1] == len(header):  # the same checks and bounds as Trajectory.load
+                            return _from_table(path, table[:, 0].copy(), table[:, 1:1 + j],
+                                               table[:, 1 + j:4 + j].copy(), joints=joints)
+        except TrajectoryFileError:
+            raise
         except (OSError, UnicodeDecodeError, ValueError):
             pass
     return Trajectory.load(path)
+
+
+def _refuse_too_large(path: Path) -> None:
+    """A trajectory file over MAX_TRAJECTORY_BYTES is refused before it is read (one line, exit 2)."""
+    try:
+        size = path.stat().st_size if path.is_file() else 0
+    except OSError:
+        return  # the reader says what is wrong with it
+    if size > MAX_TRAJECTORY_BYTES:
+        raise TrajectoryFileError(f"{path}: {size / 2**20:.0f} MB, more than the {MAX_TRAJECTORY_BYTES // 2**20} MB a "
+                                  f"trajectory file may have (what gaitbot check checks within a minute)")
 
 
 def refuse_truncated_csv(path: str | Path) -> None:

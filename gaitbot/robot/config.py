@@ -9,6 +9,9 @@ the file, the field and what is allowed::
 
 The file format is written down in docs/robot-config.md.
 
+The data classes are in gaitbot.robot.config_types (their fields are the tables' keys), finding the
+shipped robots and ConfigError in gaitbot.robot.shipped_configs; both are re-exported here.
+
 Whether the bus can carry ``gait.rate_hz`` frames at ``bus.baudrate`` is checked on load too, with the
 frame-budget arithmetic of the vendor facts (gaitbot.servos.budget): loading a robot runs no bus code.
 """
@@ -17,284 +20,32 @@ from __future__ import annotations
 
 import difflib
 import math
-from dataclasses import dataclass
-from functools import cached_property
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from gaitbot.fields import FieldError, Fields, kind, read_toml
+from gaitbot.fields import Fields, kind, read_toml
 from gaitbot.gait.balance.settings import LIMITS as BALANCE_LIMITS
 from gaitbot.gait.balance.settings import BalanceSettings
-from gaitbot.gait.steer.limits import SteerLimits
-from gaitbot.robot.steer_settings import read_steer
-from gaitbot.gait.body import LEG_LINKS, BodyGeometry, BodyModel, LinkInertial, inertia_matrix
+from gaitbot.gait.body import LEG_LINKS, LinkInertial, inertia_matrix
 from gaitbot.gait.geometry import LegGeometry
 from gaitbot.gait.joints import LEG_JOINTS, PITCH_JOINTS, PITCH_KINDS, canonical, is_leg_joint, mirror, split_joint
 from gaitbot.gait.walker import WalkSettings, make_context
-from gaitbot.robot.calibration import Calibration, angle_rad_to_ticks
+from gaitbot.robot.calibration import angle_rad_to_ticks
+from gaitbot.robot.config_types import (TORSO_HEIGHT_LEGS, BusSettings, GaitSettings, Geometry,  # noqa: F401
+                                        JointConfig, MassSettings, RobotConfig, ServoSettings, TerrainReach,
+                                        field_names)
 from gaitbot.robot.gains import GainError, gain_for_error
-from gaitbot.robot.health import HealthSettings, read_health
-from gaitbot.robot.imu_settings import ImuSettings, read_imu
-from gaitbot.servos import BACKENDS, feetech, max_servo_id, vendor
+from gaitbot.robot.health import read_health
+from gaitbot.robot.shipped_configs import (DEFAULT_ROBOT, ConfigError, default_config_path,  # noqa: F401
+                                           resolve_config, shipped_config_dirs, shipped_config_names)
+from gaitbot.robot.imu_settings import read_imu
+from gaitbot.robot.steer_settings import read_steer
+from gaitbot.servos import BACKENDS, baud_rates, feetech, max_servo_id, vendor
 from gaitbot.servos.budget import FrameBudget, check_rate
 from gaitbot.servos.models import SERVO_MODELS, ServoModel
 
-DEFAULT_ROBOT = "xl430-biped"
-
-
-class ConfigError(FieldError):
-    """A robot config is unusable. The message is one line: ``<file>: <field>: <what is wrong>``.
-
-    Other modules that check a loaded config build theirs with ``ConfigError(path,
-    field, reason)`` so every config complaint looks the same.
-    """
-
-
-# ---------------------------------------------------------------------------------------------
-# The data classes
-
-
-@dataclass(frozen=True)
-class Geometry:
-    """Leg dimensions in metres: hip-knee, knee-ankle, foot length (heel to toe), distance between
-    the hip joints, ankle axis above the sole, and heel behind the ankle axis (0: the heel is the
-    ankle projected on the sole, seed 000's foot). For 3D (gaitbot.gait.body): the sole's width
-    (None: not given; 3D robots must), its centre outward of the ankle, and the hip point below the
-    root (the pelvis frame's origin)."""
-
-    thigh_m: float
-    shank_m: float
-    foot_m: float
-    hip_width_m: float
-    ankle_height_m: float = 0.0
-    heel_back_m: float = 0.0
-    foot_width_m: float | None = None
-    sole_outward_m: float = 0.0
-    hip_below_root_m: float = 0.0
-
-    def body_geometry(self) -> BodyGeometry:
-        """The 3D leg geometry; a sole of unknown width is taken as a quarter of its length either side."""
-        width = self.foot_width_m if self.foot_width_m is not None else self.foot_m / 2
-        return BodyGeometry(self.thigh_m, self.shank_m, self.foot_m, width, self.hip_width_m, self.ankle_height_m,
-                            self.heel_back_m, self.sole_outward_m, self.hip_below_root_m)
-
-
-@dataclass(frozen=True)
-class GaitSettings:
-    """Walking parameters: cycle period (s), longest step (m), swing-foot clearance (m), frame rate (Hz)."""
-
-    cycle_s: float
-    max_step_m: float
-    clearance_m: float
-    rate_hz: float
-
-
-@dataclass(frozen=True)
-class TerrainReach:
-    """The optional ``[terrain]`` table: what one step can do between surfaces (metres), as measured by
-    tools/terrain_envelope.py: highest rise, deepest drop, widest gap stepped over on the level."""
-
-    max_rise_m: float
-    max_drop_m: float
-    max_gap_m: float
-
-
-@dataclass(frozen=True)
-class BusSettings:
-    """The serial bus. ``protocol`` is the Dynamixel protocol version; Feetech buses always get 1.0,
-    the one (Dynamixel-1.0-shaped) protocol Feetech servos speak (gaitbot.servos.feetech.PROTOCOLS)."""
-
-    backend: str
-    protocol: float
-    port: str
-    baudrate: int
-    torque_off_on_exit: bool = False
-
-
-@dataclass(frozen=True)
-class JointConfig:
-    """One servo joint.
-
-    Angles are flexion positive. ``zero_tick`` is the tick at angle 0; ``direction`` is +1 or -1
-    (-1 for mirror-mounted servos). ``hold_deg`` is set only for non-walking joints, which are
-    held at that angle while walking.
-    """
-
-    name: str
-    id: int
-    model: ServoModel
-    zero_tick: int
-    direction: int
-    min_deg: float
-    max_deg: float
-    max_velocity_dps: float
-    max_acceleration_dps2: float
-    hold_deg: float | None = None
-
-
-@dataclass(frozen=True)
-class MassSettings:
-    """Link masses in kg for the simulated robot (``[mass]``, optional): the torso (with the hip
-    servos, battery and controller) and, per leg, thigh (with the knee servo), shank (with the ankle
-    servo) and foot. The defaults make a 1.5 kg robot: 0.80 + 2 x (0.14 + 0.14 + 0.07)."""
-
-    torso_kg: float = 0.80
-    thigh_kg: float = 0.14
-    shank_kg: float = 0.14
-    foot_kg: float = 0.07
-
-    @property
-    def total_kg(self) -> float:
-        return self.torso_kg + 2.0 * (self.thigh_kg + self.shank_kg + self.foot_kg)
-
-
-@dataclass(frozen=True)
-class ServoSettings:
-    """The servos' drive (``[servo]``, optional).
-
-    ``full_torque_error_deg`` is a real setting: the position error (degrees) at which every servo's
-    position loop gives full output, smaller is stiffer. A session writes it to each servo's gain
-    register before torque goes on (gaitbot.robot.gains); None leaves the factory gains alone.
-    ``stall_torque_nm`` (N m) and ``no_load_speed_rpm`` (rev/min) override the servo models' datasheet
-    figures (gaitbot.servos.models) for the simulated robot only; None keeps them."""
-
-    stall_torque_nm: float | None = None
-    no_load_speed_rpm: float | None = None
-    full_torque_error_deg: float | None = None
-
-
-@dataclass(frozen=True)
-class RobotConfig:
-    """A whole robot: joints are the moving joints in canonical order (gaitbot.gait.joints), then the
-    held ones (``hold_deg``) in canonical order; the bus addresses them in this order."""
-
-    path: Path
-    name: str
-    geometry: Geometry
-    gait: GaitSettings
-    bus: BusSettings
-    joints: tuple[JointConfig, ...]
-    mass: MassSettings = MassSettings()
-    servo: ServoSettings = ServoSettings()
-    terrain: TerrainReach | None = None
-    calibration_file: Path | None = None  # the calibration file applied on top (gaitbot.robot.calibration_file)
-    health: HealthSettings = HealthSettings()  # [health] overrides (gaitbot.robot.health)
-    balance: BalanceSettings = BalanceSettings()
-    links: tuple[tuple[str, LinkInertial], ...] | None = None
-    boom: bool = False
-    draft: str | None = None  # [robot] draft: a config imported with placeholders (hardware refuses it)
-    steer: SteerLimits | None = None  # [steer]: steering limits (gaitbot.robot.steer_settings); None: straight only
-    imu: ImuSettings = ImuSettings()  # [imu], [feedback], [fall] (gaitbot.robot.imu_settings)
-
-    @cached_property
-    def body(self) -> BodyModel:
-        """Every link's mass: the ``[links.*]`` table, else the four ``[mass]`` segments (planar robots)."""
-        geometry = self.geometry.body_geometry()
-        if self.links is not None:
-            links = dict(self.links)
-            return BodyModel(geometry, links["torso"], {name: links[name] for name in LEG_LINKS})
-        m = self.mass
-        return BodyModel.from_segment_masses(geometry, m.torso_kg, m.thigh_kg, m.shank_kg, m.foot_kg,
-                                             TORSO_HEIGHT_LEGS * geometry.leg_length_m)
-
-    @property
-    def walking_joints(self) -> tuple[JointConfig, ...]:
-        """The joints the gait moves (no ``hold_deg``), in canonical order."""
-        return tuple(j for j in self.joints if j.hold_deg is None)
-
-    @property
-    def held_joints(self) -> tuple[JointConfig, ...]:
-        return tuple(j for j in self.joints if j.hold_deg is not None)
-
-    @property
-    def walking_joint_names(self) -> tuple[str, ...]:
-        return tuple(j.name for j in self.walking_joints)
-
-    @property
-    def is_3d(self) -> bool:
-        """True when the legs move in roll as well as pitch (hip and ankle roll joints that walk):
-        such a robot can shift its weight sideways over one foot; a pitch-only one needs a boom."""
-        return "hip_roll_left" in self.walking_joint_names and "ankle_roll_left" in self.walking_joint_names
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        return tuple(j.name for j in self.joints)
-
-    @property
-    def ids(self) -> tuple[int, ...]:
-        """Servo ids in joint order."""
-        return tuple(j.id for j in self.joints)
-
-    @cached_property
-    def calibration(self) -> Calibration:
-        """Angles <-> ticks for every joint, built once per config."""
-        return Calibration.of(self.joints)
-
-    @property
-    def models_by_id(self) -> dict[int, ServoModel]:
-        """Servo model per id, in joint order (what the bus backends take as ``models``)."""
-        return {j.id: j.model for j in self.joints}
-
-    def joint(self, name: str) -> JointConfig:
-        for j in self.joints:
-            if j.name == name:
-                return j
-        raise KeyError(f"{self.path}: no joint {name!r} (joints: {', '.join(self.joint_names)})")
-
-
-# ---------------------------------------------------------------------------------------------
-# Finding the shipped configs
-
-
-def shipped_config_dirs() -> list[Path]:
-    """Directories holding the shipped robot files: the wheel's ``gaitbot/_config`` first (pyproject
-    force-includes the top-level ``config/`` there), then ``<repo>/config`` for source checkouts."""
-    dirs: list[Path] = []
-    try:
-        packaged = resources.files("gaitbot") / "_config"
-        if isinstance(packaged, Path) and packaged.is_dir():
-            dirs.append(packaged)
-    except (ModuleNotFoundError, OSError):  # pragma: no cover - gaitbot is importable if we run
-        pass
-    checkout = Path(__file__).resolve().parents[2]
-    # Only a source checkout (pyproject.toml beside gaitbot/): in an installed wheel parents[2] is
-    # site-packages, where a "config" directory would belong to some other distribution.
-    if (checkout / "pyproject.toml").is_file() and (checkout / "config").is_dir():
-        dirs.append(checkout / "config")
-    return dirs
-
-
-def shipped_config_names() -> list[str]:
-    """Names of the shipped robots (file stems), sorted."""
-    return sorted({p.stem for d in shipped_config_dirs() for p in d.glob("*.toml")})
-
-
-def resolve_config(name_or_path: str | Path) -> Path:
-    """A config file from a path, or from the bare name of a shipped robot (``xl430-biped``).
-
-    An existing file wins; otherwise a bare name (no directory part) is looked up among the shipped
-    configs. Raises ConfigError listing the shipped names when neither exists.
-    """
-    path = Path(name_or_path)
-    if path.is_file():
-        return path
-    text = str(name_or_path)
-    if len(path.parts) == 1:
-        stem = text[:-5] if text.endswith(".toml") else text
-        for directory in shipped_config_dirs():
-            candidate = directory / f"{stem}.toml"
-            if candidate.is_file():
-                return candidate
-    shipped = ", ".join(shipped_config_names()) or "none found"
-    raise ConfigError(text, "file", f"no such file, and not the name of a shipped robot (shipped: {shipped})")
-
-
-def default_config_path() -> Path:
-    """The built-in default robot's file (xl430-biped)."""
-    return resolve_config(DEFAULT_ROBOT)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -338,25 +89,22 @@ MASS_RANGE_KG = (0.0, 1000.0, "kg")
 #: The swing foot's clearance may be at most this share of the leg (thigh + shank).
 CLEARANCE_SHARE_OF_LEG = 0.25
 
-TORSO_HEIGHT_LEGS = 0.6
-"""A planar robot's torso (``[mass] torso_kg``) is a box this many leg lengths tall standing on the hips."""
 MASS_TOLERANCE_KG = 1e-4
 """``[mass] total_kg`` must equal the links' sum within this (0.1 g: the files hold 6 digits)."""
 
 _TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain", "health", "balance", "links",
              "steer", "imu", "feedback", "fall")
-_MASS_KEYS = ("torso_kg", "thigh_kg", "shank_kg", "foot_kg", "total_kg")
+# Each table's allowed keys are its data class's fields (gaitbot.robot.config_types): written once.
+_MASS_KEYS = field_names(MassSettings) + ("total_kg",)
 _LINK_NAMES = ("torso",) + LEG_LINKS
-_LINK_KEYS = ("mass_kg", "com_m", "inertia_kg_m2")
-_SERVO_KEYS = ("stall_torque_nm", "no_load_speed_rpm", "full_torque_error_deg")
-_TERRAIN_KEYS = ("max_rise_m", "max_drop_m", "max_gap_m")
+_LINK_KEYS = field_names(LinkInertial)
+_SERVO_KEYS = field_names(ServoSettings)
+_TERRAIN_KEYS = field_names(TerrainReach)
 _ROBOT_KEYS = ("name", "boom", "draft")
-_GEOMETRY_KEYS = ("thigh_m", "shank_m", "foot_m", "hip_width_m", "ankle_height_m", "heel_back_m", "foot_width_m",
-                  "sole_outward_m", "hip_below_root_m")
-_GAIT_KEYS = ("cycle_s", "max_step_m", "clearance_m", "rate_hz")
-_BUS_KEYS = ("backend", "protocol", "port", "baudrate", "torque_off_on_exit")
-_JOINT_KEYS = ("id", "model", "zero_tick", "direction", "min_deg", "max_deg", "max_velocity_dps",
-               "max_acceleration_dps2", "hold_deg")
+_GEOMETRY_KEYS = field_names(Geometry)
+_GAIT_KEYS = field_names(GaitSettings)
+_BUS_KEYS = field_names(BusSettings)
+_JOINT_KEYS = field_names(JointConfig, without=("name",))
 
 
 class _Reader(Fields):
@@ -377,7 +125,7 @@ class _Reader(Fields):
         joints = self.joints(data, bus)
         boom = self.boolean(robot, "boom", "robot", default=False)
         draft = self.string(robot, "draft", "robot") if "draft" in robot else None
-        links = self.links(data) if "links" in data else None
+        links = self.links(data, geometry) if "links" in data else None
         mass = self.mass(self.optional_table(data, "mass", "mass", _MASS_KEYS), links)
         servo = self.servo(self.optional_table(data, "servo", "servo", _SERVO_KEYS))
         self.gains_settable(joints, servo)
@@ -438,21 +186,39 @@ class _Reader(Fields):
                                                  f"= {mass.total_kg:.6f} kg")
         return mass
 
-    def links(self, data: dict) -> tuple[tuple[str, LinkInertial], ...]:
-        """``[links.<name>]``: mass, centre of mass and inertia of the torso and the left leg's six links."""
+    def links(self, data: dict, geometry: Geometry) -> tuple[tuple[str, LinkInertial], ...]:
+        """``[links.<name>]``: mass, centre of mass and inertia of the torso and the left leg's six links.
+
+        Physical ranges: a link's centre of mass lies within the robot's reach of its joint (the leg, thigh +
+        shank + foot: no link of a biped is larger), and its inertia is a rigid body's: principal moments
+        positive (zero for a massless link), none larger than the other two together, and none larger than
+        mass x reach^2 (all of a link's mass within the reach of its centre)."""
         tables = self.table(data, "links", "links", _LINK_NAMES)
+        reach_m = geometry.thigh_m + geometry.shank_m + geometry.foot_m
         out = []
         for name in _LINK_NAMES:
             f = f"links.{name}"
             t = self.table(tables, name, f, _LINK_KEYS)
             mass = self.number(t, "mass_kg", f, positive=name == "torso", non_negative=True, within=MASS_RANGE_KG)
             com = self.vector(t, "com_m", f, 3, "[x, y, z] in metres")
-            inertia = inertia_matrix(*self.vector(t, "inertia_kg_m2", f, 6, "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] in kg m^2"))
+            distance_m = math.sqrt(sum(c * c for c in com)) if all(abs(c) < 1e100 for c in com) else math.inf
+            if distance_m > reach_m:
+                raise self.fail(f"{f}.com_m", f"{distance_m:.3g} m from the link's joint, beyond the robot's reach "
+                                              f"(thigh_m + shank_m + foot_m = {reach_m:g} m)")
+            values = self.vector(t, "inertia_kg_m2", f, 6, "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] in kg m^2")
+            largest = mass * reach_m ** 2
+            for i, value in enumerate(values):
+                if not abs(value) <= largest:
+                    raise self.fail(f"{f}.inertia_kg_m2[{i}]", f"{value:g} kg m^2 is more than a {mass:g} kg link within "
+                                                               f"the robot's reach can have (mass_kg x {reach_m:g}^2 = "
+                                                               f"{largest:.3g} kg m^2)")
+            inertia = inertia_matrix(*values)
             moments = np.linalg.eigvalsh(inertia)
             scale = max(float(moments.max()), 1e-12)
-            if moments.min() < -1e-9 * scale or moments.max() > moments.sum() - moments.max() + 1e-9 * scale:
+            positive = moments.min() > 0 if mass > 0 else moments.min() >= -1e-9 * scale
+            if not positive or moments.max() > moments.sum() - moments.max() + 1e-9 * scale:
                 raise self.fail(f"{f}.inertia_kg_m2", "is not the inertia of a rigid body (its principal moments "
-                                                      f"{', '.join(f'{m:.3g}' for m in moments)} must be >= 0 and "
+                                                      f"{', '.join(f'{m:.3g}' for m in moments)} must be > 0 and "
                                                       "none larger than the other two together)")
             out.append((name, LinkInertial(mass, np.array(com), inertia)))
         return tuple(out)
@@ -625,6 +391,11 @@ class _Reader(Fields):
             spoken = ", ".join(str(p) for p in model.protocols)
             raise self.fail("bus.protocol", f"{model_name} ({f}) does not speak protocol {bus.protocol} "
                                             f"(it speaks {spoken})")
+
+        rates = sorted(set(baud_rates(model_name).values()), reverse=True)
+        if bus.baudrate not in rates:  # the model's Baud Rate register (ROBOTIS e-Manual, Feetech's memory table)
+            raise self.fail("bus.baudrate", f"a {model_name} ({name}) cannot run at {bus.baudrate:,} baud (its Baud "
+                                            f"Rate register allows: {', '.join(map(str, rates))})")
 
         max_id = max_servo_id(bus.backend, bus.protocol)
         servo_id = self.integer(t, "id", f, f"an integer servo id 0..{max_id}")

@@ -12,6 +12,7 @@ from gaitbot.gait.terrain.envelope import StepEnvelope
 from gaitbot.gait.terrain.walk import TerrainSettings, default_weights
 from gaitbot.gait.walker import WalkSettings
 from gaitbot.robot.config import RobotConfig
+from gaitbot.robot.motion_margin import PLANNED_SHARE
 
 
 def leg_geometry(config: RobotConfig) -> LegGeometry:
@@ -49,10 +50,11 @@ class GaitSource:
 
 
 def joint_limits_ticks(config: RobotConfig) -> tuple[float, float]:
-    """The slowest joint's velocity and acceleration limits in ticks/s and ticks/s^2 (for ramps)."""
+    """What ramps are planned at, in ticks/s and ticks/s^2: the slowest joint's velocity and acceleration
+    limits times PLANNED_SHARE (gaitbot.robot.motion_margin)."""
     vel = min(math.radians(j.max_velocity_dps) * j.model.ticks_per_rad for j in config.joints)
     acc = min(math.radians(j.max_acceleration_dps2) * j.model.ticks_per_rad for j in config.joints)
-    return vel, acc
+    return PLANNED_SHARE * vel, PLANNED_SHARE * acc
 
 
 def terrain_envelope(source: GaitSource, course: Course) -> StepEnvelope:

@@ -5,11 +5,13 @@ so sleep overshoot and bus jitter cannot add up into drift over long runs. A fra
 deadline is sent late and counted. No frame is ever skipped: every frame is part of a trajectory
 whose velocities and accelerations were limit-checked, and skipping one would double a step. No
 burst is sent to catch up either: two goals sent back to back would do the same. So frame k goes
-out at ``max(deadline_k, previous_send + min_frame_interval_s)``. The default is ``0.9 * period``:
-after a stall (say one 40 ms USB hiccup) the stream gets back onto its original deadlines at a
-tenth of a period per frame, and meanwhile the servos move at most 1/0.9 = 1.11 times the planned
-speed. Later frames keep their absolute deadlines, and the ones sent during recovery are counted as
-late against them.
+out at ``max(deadline_k, previous_send + min_frame_interval_s)``: after a stall the motion is
+stretched, never bunched. The default is MIN_SEND_INTERVAL_SHARE (0.95) of a period
+(gaitbot.robot.motion_margin): after a stall (say one 40 ms USB hiccup) the stream gets back onto
+its original deadlines at a twentieth of a period per frame, and meanwhile the servos move at most
+1/0.95 = 1.053 times the planned speed, which the planning margin (PLANNED_SHARE, 0.9) covers: at
+send times a planned motion stays under 0.947 of its limits. Later frames keep their absolute
+deadlines, and the ones sent during recovery are counted as late against them.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gaitbot.bus.base import Bus
+from gaitbot.robot.motion_margin import MIN_SEND_INTERVAL_SHARE
 from gaitbot.stream.clock import Clock, MonotonicClock
 
 #: A frame is late when it starts more than this after its deadline. 0.5 ms is 3 % of a
@@ -181,7 +184,8 @@ class Streamer:
         self.clock = clock if clock is not None else MonotonicClock()
         self.on_frame = on_frame
         self.late_threshold_s = late_threshold_s
-        self.min_frame_interval_s = 0.9 * self.period_s if min_frame_interval_s is None else min_frame_interval_s
+        self.min_frame_interval_s = (MIN_SEND_INTERVAL_SHARE * self.period_s if min_frame_interval_s is None
+                                     else min_frame_interval_s)
         self.cpu_time_s = cpu_time_s
         self.monitor = monitor
         self.feedback = feedback  # gaitbot.feel.Feedback: corrects each row from the IMU (None: as planned)

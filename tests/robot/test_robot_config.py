@@ -416,13 +416,13 @@ def test_config_module_does_not_import_the_bus_room():
 
 @pytest.mark.parametrize("name", SHIPPED)
 def test_shipped_configs_fit_the_bus_frame_budget_on_load(tmp_path, name):
-    """Every shipped robot carries 60 Hz with read-back at its baud rate, and none can at 9600 baud
+    """Every shipped robot carries 60 Hz with read-back at its baud rate, and none can at 57600 baud
     (8 servos x ~14 bytes x 10 bits > 0.7 x 16.7 ms): refused on load, naming gait.rate_hz."""
     load_robot_config(resolve_config(name))
-    slow = re.sub(r"(?m)^baudrate = \d+", "baudrate = 9600", shipped_text(name))
+    slow = re.sub(r"(?m)^baudrate = \d+", "baudrate = 57600", shipped_text(name))
     path = tmp_path / "slow.toml"
     path.write_text(slow)
-    with pytest.raises(ConfigError, match=r"gait\.rate_hz: .* too fast for .* at 9600 baud"):
+    with pytest.raises(ConfigError, match=r"gait\.rate_hz: .* too fast for .* at 57600 baud"):
         load_robot_config(path)
 
 

@@ -19,6 +19,7 @@ from gaitbot.bus.base import Bus, BusError, ServoTimeout
 from gaitbot.stream.clock import MonotonicClock, VirtualClock
 from gaitbot.stream.ramps import brake_ticks, ramp_ticks, stop_ticks
 from gaitbot.bus.serial_latency import latency_timer_warning
+from gaitbot.robot.motion_margin import MIN_SEND_INTERVAL_SHARE
 from gaitbot.stream import (
     EXIT_CODES, MissingServosError, Streamer, prepare, walk_session,
 )
@@ -175,39 +176,40 @@ def test_stalls_do_not_shift_later_deadlines():
     stall_frames = np.arange(0, 10_000, 997)
     for k in stall_frames[:-1]:
         # after a stall of 2.3 periods the next frame is 1.3 periods late and recovers
-        # a tenth of a period per frame: 13 late frames, then back on the grid
+        # a twentieth of a period per frame (MIN_SEND_INTERVAL_SHARE 0.95): 26 late frames, then on the grid
         assert lateness_s[k + 1] == pytest.approx(1.3 * PERIOD_S, abs=1e-9)
-        assert np.abs(lateness_s[k + 14: k + 997]).max() < 1e-9
-    assert np.diff(bus.write_times()).min() >= 0.9 * PERIOD_S - 1e-9  # never a burst
+        assert np.abs(lateness_s[k + 27: k + 997]).max() < 1e-9
+    assert np.diff(bus.write_times()).min() >= MIN_SEND_INTERVAL_SHARE * PERIOD_S - 1e-9  # never a burst
 
 
 def test_late_frame_is_counted_and_not_followed_by_a_catch_up_burst():
     # Frame 10's write takes 2.5 periods: frame 11 goes out 1.5 periods late; each later
-    # frame waits at least 0.9 period, so lateness falls by 0.1 period a frame:
-    # frames 11..25 are late by 1.5, 1.4, ..., 0.1 periods (15 frames), frame 26 is on time.
+    # frame waits at least 0.95 period (MIN_SEND_INTERVAL_SHARE), so lateness falls by 0.05 period a frame:
+    # frames 11..40 are late by 1.5, 1.45, ..., 0.05 periods (30 frames), frame 41 is on time.
+    assert MIN_SEND_INTERVAL_SHARE == 0.95
     costs = {10: 2.5 * PERIOD_S}
-    bus, stats = run_frames(lambda i: costs.get(i, 0.1 * PERIOD_S), 40)
+    bus, stats = run_frames(lambda i: costs.get(i, 0.1 * PERIOD_S), 60)
     times_s = bus.write_times()
-    lateness_s = times_s - (100.0 + np.arange(40) * PERIOD_S)
-    expected_periods = np.zeros(40)
-    expected_periods[11:26] = 1.5 - 0.1 * np.arange(15)
+    lateness_s = times_s - (100.0 + np.arange(60) * PERIOD_S)
+    expected_periods = np.zeros(60)
+    expected_periods[11:41] = 1.5 - 0.05 * np.arange(30)
     np.testing.assert_allclose(lateness_s / PERIOD_S, expected_periods, atol=1e-9)
-    assert stats.late_frames == 15
-    assert np.diff(times_s).min() >= 0.9 * PERIOD_S - 1e-9
-    assert stats.frames == 40  # nothing skipped
+    assert stats.late_frames == 30
+    assert np.diff(times_s).min() >= 0.95 * PERIOD_S - 1e-9
+    assert stats.frames == 60  # nothing skipped
 
 
 def test_stats_against_hand_computation():
     # 100 frames; frame 20's write costs a period + 4 ms, every other write 1 ms.
     # Frame 21 is due at 21P but the bus is busy until 21P + 4 ms: late 4 ms.
-    # Frame 22 waits until send21 + 0.9P = 22P + 4 ms - P/10: late 2.3333 ms.
-    # Frame 23: late 0.6667 ms (> 0.5 ms threshold). Frame 24 would be 1 ms early: on time.
+    # Frame 22 waits until send21 + 0.95P = 22P + 4 ms - P/20: late 3.1667 ms; then 2.3333, 1.5 and
+    # 0.6667 ms (> 0.5 ms threshold). Frame 26 would be 0.17 ms early: on time.
     p = PERIOD_S
     costs = {20: p + 0.004}
     bus, stats = run_frames(lambda i: costs.get(i, 0.001), 100)
-    late_ms = [4.0, 4.0 - p * 1e3 / 10, 4.0 - 2 * p * 1e3 / 10]
+    late_ms = [4.0 - k * p * 1e3 / 20 for k in range(5)]
     assert stats.frames == 100
-    assert stats.late_frames == 3
+    assert stats.late_frames == 5
     assert stats.max_lateness_s == pytest.approx(4e-3, abs=1e-12)
     assert stats.lateness_median_s == pytest.approx(0.0, abs=1e-12)
     # numpy linear percentile: position 0.99 * 99 = 98.01 between sorted[98] and sorted[99]
@@ -220,11 +222,11 @@ def test_stats_against_hand_computation():
     assert stats.wall_s == pytest.approx(99 * p + 0.001, abs=1e-9)
     assert stats.last_lateness_s == pytest.approx(0.0, abs=1e-12)
     d = stats.to_dict()
-    assert d["frames"] == 100 and d["late_frames"] == 3
+    assert d["frames"] == 100 and d["late_frames"] == 5
     assert d["lateness_max_s"] == pytest.approx(4e-3, abs=1e-12)
     assert 0.0 <= d["work_cpu_per_frame_s"] * 100 <= d["cpu_per_frame_s"] * 100 + 1e-9
     text = stats.summary()
-    assert "100 frames" in text and "3 late" in text and "4.000 ms" in text
+    assert "100 frames" in text and "5 late" in text and "4.000 ms" in text
 
 
 def test_bus_call_median_with_an_even_count():

@@ -438,10 +438,10 @@ def is_model_file(path: str | Path) -> bool:
     if not path.is_file():
         return False
     try:
-        with np.load(path, allow_pickle=False) as z:
-            return "kind" in z.files and str(z["kind"]) == MODEL_KIND
-    except Exception:
+        arrays = read_npz(path, only=("kind",))  # every header checked first: a hostile file is not loaded
+    except (OSError, NpzProblem):
         return False
+    return "kind" in arrays and str(arrays["kind"]) == MODEL_KIND
 
 
 def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: float,
