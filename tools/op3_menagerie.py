@@ -160,11 +160,16 @@ class ForeignResult:
     max_abs_yaw_deg: float = 0.0
     torso_roll_rms_deg: float = 0.0
     torso_pitch_rms_deg: float = 0.0
+    final_x_m: float = 0.0  # the torso's last position from its start (world)
+    final_y_m: float = 0.0
+    heading_deg: float = 0.0  # the torso's yaw change, unwrapped (a full turn is 360)
 
 
-def play(trajectory, rate_hz: float, friction: float = 1.0, push_n_s: float = 0.0, push_at_s: float = 0.0) -> ForeignResult:
+def play(trajectory, rate_hz: float, friction: float = 1.0, push_n_s: float = 0.0, push_at_s: float = 0.0,
+         kp_nm_per_rad: float | None = None) -> ForeignResult:
     """Play a trajectory's angles (our 12 leg joints, open loop: each frame's goals held 1 / rate_hz) on the
-    foreign model, standing in the first frame's pose; measure until SETTLE_AFTER_S after the last frame."""
+    foreign model, standing in the first frame's pose; measure until SETTLE_AFTER_S after the last frame.
+    kp_nm_per_rad: the leg servos' stiffness (default: the model's own 21.1; gaitbot writes ~39 to an OP3)."""
     import mujoco
 
     model = mujoco.MjModel.from_xml_string(menagerie_mjcf(friction))
@@ -175,6 +180,9 @@ def play(trajectory, rate_hz: float, friction: float = 1.0, push_n_s: float = 0.
     act = np.array([actuator[model.joint(t).id] for t, _ in theirs])
     qadr = np.array([model.joint(t).qposadr[0] for t, _ in theirs])
     signs = np.array([s for _, s in theirs], dtype=float)
+    if kp_nm_per_rad is not None:
+        model.actuator_gainprm[act, 0] = kp_nm_per_rad
+        model.actuator_biasprm[act, 1] = -kp_nm_per_rad
     goals = trajectory.angles_of(names)
     root = trajectory.root_m
     data.qpos[:3] = root[0]
@@ -215,6 +223,8 @@ def play(trajectory, rate_hz: float, friction: float = 1.0, push_n_s: float = 0.
     result.distance_travelled_m = float(data.qpos[0] - start[0])
     result.lateral_drift_m = float(data.qpos[1] - start[1] - (root[-1, 1] - root[0, 1]))
     result.max_abs_yaw_deg = float(np.abs(rpy[:, 2]).max())
+    result.final_x_m, result.final_y_m = float(data.qpos[0] - start[0]), float(data.qpos[1] - start[1])
+    result.heading_deg = float(np.degrees(np.unwrap(np.radians(rpy[:, 2])))[-1] - rpy[0, 2])
     result.torso_roll_rms_deg = float(np.sqrt(np.mean(rpy[:, 0] ** 2)))
     result.torso_pitch_rms_deg = float(np.sqrt(np.mean(rpy[:, 1] ** 2)))
     return result

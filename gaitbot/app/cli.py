@@ -31,6 +31,7 @@ import warnings  # noqa: E402
 
 from gaitbot import __version__  # noqa: E402
 from gaitbot.app.help import COMMAND_HELP, DESCRIPTION, EPILOG, HelpFormatter  # noqa: E402
+from gaitbot.app.steer_options import add_steer_options, steer_sources  # noqa: E402
 from gaitbot.errors import UserError  # noqa: E402
 from gaitbot.stream.signals import StopSignals, Terminated  # noqa: E402 - light: rooms come with the commands
 
@@ -91,6 +92,7 @@ def _walk_inputs(p: argparse.ArgumentParser, demo: bool = False) -> None:
                    "(default: the robot's cycle_s)")
     p.add_argument("--terrain", metavar="FILE", help="walk a terrain course (TOML, see config/terrain/) instead of "
                    "--steps/--distance")
+    add_steer_options(p)  # --velocity/--duration, --commands (gaitbot.app.steer_options)
 
 
 def _bus_options(p: argparse.ArgumentParser, dry_run_help: str) -> None:
@@ -246,6 +248,9 @@ def check_sources(parser: argparse.ArgumentParser, args) -> None:
         return
     own = parser.commands[args.command]
     sources = [name for name in ("steps", "distance", "terrain", "trajectory") if getattr(args, name, None) is not None]
+    sources += steer_sources(args)
+    if "velocity" in sources and "distance" in sources:  # --velocity VX,0,0 --distance M: one straight walk
+        sources.remove("distance")
     if len(sources) > 1:
         own.error(f"give one of --{' / --'.join(sources)}, not several")
     if sources:
@@ -255,7 +260,7 @@ def check_sources(parser: argparse.ArgumentParser, args) -> None:
         args.demo = True  # said by the walk once its other options are found good (app/walk.py)
         return
     extra = " or --trajectory" if args.command == "walk" else ""
-    own.error(f"give --steps, --distance or --terrain{extra} (e.g. --distance 1.0)")
+    own.error(f"give --steps, --distance, --velocity, --commands or --terrain{extra} (e.g. --distance 1.0)")
 
 
 def _closed_output() -> int:

@@ -6,6 +6,8 @@ import json
 import math
 
 from gaitbot.app.options import walked_by
+from gaitbot.app.steer_options import steer_requested
+from gaitbot.app.steer_walk import print_steered_plan, steered_plan_summary
 from gaitbot.app.walks import trajectory_for_robot
 from gaitbot.gait.walker import OnlineWalker
 from gaitbot.robot.walk_settings import GaitSource
@@ -15,6 +17,10 @@ def run(args) -> int:
     if getattr(args, "terrain", None) is not None:
         return _plan_terrain(args)
     source, walker, _ = trajectory_for_robot(args)
+    if steer_requested(args):
+        summary = steered_plan_summary(source, walker)
+        print(json.dumps(summary, indent=2)) if args.json else print_steered_plan(summary)
+        return 0
     plan = balanced_plan_summary(source, walker) if source.balanced else plan_summary(source, walker)
     if args.json:
         print(json.dumps(plan, indent=2))

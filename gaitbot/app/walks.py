@@ -11,6 +11,8 @@ import numpy as np
 
 from gaitbot.app.options import UsageError, check_rate_option, file_option, gait_source, step_lengths
 from gaitbot.app.progress import callback, progress
+from gaitbot.app.steer_options import steer_requested
+from gaitbot.app.steer_walk import steered_walk
 from gaitbot.gait.footfall import detect_heel_strikes
 from gaitbot.gait.segments import GaitGenerationError
 from gaitbot.gait.step_length import StepLengthError
@@ -115,6 +117,8 @@ def trajectory_for_robot(args, goals: bool = False) -> tuple[GaitSource, OnlineW
     (servo-sag feedforward included); a planar walk's are the same."""
     if getattr(args, "trajectory", None) is not None:
         return trajectory_file_walk(args)
+    if steer_requested(args):
+        return steered_walk(args, goals)
     if getattr(args, "terrain", None) is not None:
         source = gait_source(args)
         if source.balanced:

@@ -1,7 +1,8 @@
 """The check ``gaitbot walk`` runs before anything moves: the same code as ``gaitbot check``.
 
-Joint limits (check/trajectory.py) and balance (check/balance.py): a walk that would tip the robot is
-refused like one that breaks a limit, unless the robot walks on a boom.
+Joint limits (check/trajectory.py), balance (check/balance.py) and the feet's clearance from each other
+(check/feet.py): a walk that would tip the robot or make its feet touch is refused like one that breaks a
+limit, unless the robot walks on a boom.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from dataclasses import replace
 import numpy as np
 
 from gaitbot.check.balance import CONTACT_TOL_M, balance_trace, tipping_direction
+from gaitbot.check.feet import feet_episodes, feet_margin_m, sole_gaps_m
 from gaitbot.check.trajectory import BalanceSummary, CheckReport, Violation, check_trajectory, trajectory_angles_deg
 from gaitbot.errors import UserError
 from gaitbot.gait.trajectory import Trajectory
@@ -47,12 +49,15 @@ def preflight(config: RobotConfig, trajectory: Trajectory, margin_deg: float = 0
     trace = balance_trace(config, trajectory, angles)
     outside = trace.margin_m < 0
     found = _balance_episodes(trace, outside) + _sinking_episodes(trace)
+    gaps = sole_gaps_m(trace.soles)  # the feet's clearance from each other (check/feet.py)
+    found += feet_episodes(trace.t_s, gaps, feet_margin_m(config))
     supported = np.isfinite(trace.margin_m)
     k = int(np.argmin(np.where(supported, trace.margin_m, np.inf))) if supported.any() else 0
+    g = int(np.argmin(gaps))
     summary = BalanceSummary(True, "", float(1e3 * trace.margin_m[k]) if supported.any() else 0.0,
                              float(trace.t_s[k]), int(outside.sum()),
                              tuple(float(v) for v in trace.com_m[-1, :2] - trace.com_m[0, :2]),
-                             int((~supported).sum()))
+                             int((~supported).sum()), float(1e3 * gaps[g]), float(trace.t_s[g]))
     violations = tuple(sorted(report.violations + tuple(found), key=lambda v: v.t_s))
     return replace(report, violations=violations, balance=summary)
 

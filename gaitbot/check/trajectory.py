@@ -37,9 +37,9 @@ ACCELERATION_METHOD = ("second differences with non-uniform spacing, 2*(v[k+1/2]
 #: The longest period a frame change is measured over (1 / 10 Hz, the lowest rate a walk streams at):
 #: a goal 45 deg away is a 45 deg jump whether it comes 0.1 s or 1000 s after the one before.
 MAX_FRAME_PERIOD_S = 0.1
-KIND_ORDER = ("position", "tick_range", "wrap_seam", "velocity", "acceleration", "balance")
+KIND_ORDER = ("position", "tick_range", "wrap_seam", "velocity", "acceleration", "balance", "feet")
 _UNITS = {"position": "deg", "tick_range": "ticks", "wrap_seam": "ticks", "velocity": "deg/s",
-          "acceleration": "deg/s^2", "balance": "mm"}
+          "acceleration": "deg/s^2", "balance": "mm", "feet": "mm"}
 
 
 @dataclass(frozen=True)
@@ -76,6 +76,9 @@ class Violation:
                     f"root? docs/file-formats.md)")
         elif self.kind == "balance" and self.joint == "support":
             what = f"no sole touches the ground at t={self.t_s:.3f} s (the trajectory lifts both feet)"
+        elif self.kind == "feet":
+            what = (f"the soles come within {self.value:.1f} mm of each other at t={self.t_s:.3f} s (the least gap "
+                    f"allowed: {self.limit:.1f} mm; negative: they overlap)")
         elif self.kind == "balance":
             what = (f"{self.value:.1f} mm outside the support polygon at t={self.t_s:.3f} s: the robot would tip "
                     f"{self.limit_name}")
@@ -129,6 +132,8 @@ class BalanceSummary:
     frames_outside: int = 0
     com_travel_m: tuple[float, float] = (0.0, 0.0)
     frames_without_support: int = 0
+    least_sole_gap_mm: float | None = None  # the soles' least gap over the walk (check/feet.py)
+    least_sole_gap_t_s: float = 0.0
 
     def describe(self) -> str:
         if not self.checked:
@@ -139,7 +144,12 @@ class BalanceSummary:
         return (f"ZMP {'inside' if self.frames_outside == 0 else 'outside'} the support polygon"
                 f"{'' if self.frames_outside == 0 else f' in {self.frames_outside} frames'}; closest "
                 f"{abs(self.closest_margin_mm):.1f} mm {where} an edge at t={self.closest_t_s:.3f} s "
-                f"(centre of mass and ZMP of every link's mass, docs/checking.md)")
+                f"(centre of mass and ZMP of every link's mass, docs/checking.md)" + self._feet())
+
+    def _feet(self) -> str:
+        if self.least_sole_gap_mm is None:
+            return ""
+        return f"; the soles at least {self.least_sole_gap_mm:.1f} mm apart (at t={self.least_sole_gap_t_s:.3f} s)"
 
 
 @dataclass(frozen=True)

@@ -30,6 +30,8 @@ import numpy as np
 from gaitbot.fields import FieldError, Fields, kind, read_toml
 from gaitbot.gait.balance.settings import LIMITS as BALANCE_LIMITS
 from gaitbot.gait.balance.settings import BalanceSettings
+from gaitbot.gait.steer.limits import SteerLimits
+from gaitbot.robot.steer_settings import read_steer
 from gaitbot.gait.body import LEG_LINKS, BodyGeometry, BodyModel, LinkInertial, inertia_matrix
 from gaitbot.gait.geometry import LegGeometry
 from gaitbot.gait.joints import LEG_JOINTS, PITCH_JOINTS, PITCH_KINDS, canonical, is_leg_joint, mirror, split_joint
@@ -183,6 +185,7 @@ class RobotConfig:
     balance: BalanceSettings = BalanceSettings()
     links: tuple[tuple[str, LinkInertial], ...] | None = None
     boom: bool = False
+    steer: SteerLimits | None = None  # [steer]: steering limits (gaitbot.robot.steer_settings); None: straight only
 
     @cached_property
     def body(self) -> BodyModel:
@@ -337,7 +340,8 @@ TORSO_HEIGHT_LEGS = 0.6
 MASS_TOLERANCE_KG = 1e-4
 """``[mass] total_kg`` must equal the links' sum within this (0.1 g: the files hold 6 digits)."""
 
-_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain", "health", "balance", "links")
+_TOP_KEYS = ("robot", "geometry", "gait", "bus", "joints", "mass", "servo", "terrain", "health", "balance", "links",
+             "steer")
 _MASS_KEYS = ("torso_kg", "thigh_kg", "shank_kg", "foot_kg", "total_kg")
 _LINK_NAMES = ("torso",) + LEG_LINKS
 _LINK_KEYS = ("mass_kg", "com_m", "inertia_kg_m2")
@@ -383,7 +387,7 @@ class _Reader(Fields):
         balance = self.balance(self.optional_table(data, "balance", "balance", BalanceSettings.field_names()))
         config = RobotConfig(path=self.path, name=name, geometry=geometry, gait=gait, bus=bus, joints=joints,
                              mass=mass, servo=servo, terrain=terrain, health=health, balance=balance, links=links,
-                             boom=boom)
+                             boom=boom, steer=read_steer(self, data))
         self.three_d_checks(config)
         return config
 

@@ -136,6 +136,7 @@ class SimReport:
     heel_strikes: tuple[dict, ...] = ()
     max_foothold_error_m: float | None = None
     push: dict | None = None
+    heading_deg: float = 0.0  # the torso's yaw change over the run, unwrapped (a steered walk's full turn: 360)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -320,7 +321,8 @@ class WalkMeter:
             max_abs_yaw_deg=float(np.abs(rpy[:, 2]).max()) if len(rpy) else 0.0,
             torso_roll_rms_deg=roll[0], torso_roll_max_deg=roll[1], torso_pitch_rms_deg=pitch[0],
             torso_pitch_max_deg=pitch[1], heel_strikes=tuple(self.strikes),
-            max_foothold_error_m=max(errors) if errors else None, push=push)
+            max_foothold_error_m=max(errors) if errors else None, push=push,
+            heading_deg=float(np.degrees(np.unwrap(np.radians(rpy[:, 2])))[-1]) if len(rpy) else 0.0)
 
     def _scuff_fraction(self, times: np.ndarray, plan: WalkPlan) -> float:
         """Touching time over window time; a sample at t covers the frame (t - frame, t]."""

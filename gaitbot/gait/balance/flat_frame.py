@@ -6,6 +6,10 @@ that is ~1.5 ms a frame, over the 1 ms budget. For the straight walk the balance
 upright, soles flat, no yaw) the leg IK and the link CoMs reduce to a few rotations about x and y,
 done here with the math module (~10x faster). tests/gait/test_balance_walker.py checks it against the
 vectorised gaitbot.gait.kinematics6 / gaitbot.gait.mass to 1e-12.
+
+Turned feet (steering): the torso turns by the mean of the feet's yaws and each hip yaw joint turns its
+foot by the rest; a leg's links then turn about its hip point, the rest is the flat-foot algebra in the
+foot's frame. ``yaws=None`` (or both 0) keeps the straight walk's arithmetic exactly.
 """
 
 from __future__ import annotations
@@ -30,9 +34,13 @@ class FlatFootBody:
         self.link_com = {s: [tuple(float(v) for v in body.leg_link(n, s).com_m) for n in LEG_LINKS] for s in SIDES}
         self.total_kg = self.torso_kg + 2 * sum(self.link_kg)
 
-    def leg_ik(self, side: str, rx: float, ry: float, rz: float) -> list[float]:
-        """One leg's six angles for r = hip - ankle (root frame); the foot flat, toe straight ahead."""
+    def leg_ik(self, side: str, rx: float, ry: float, rz: float, gamma: float = 0.0) -> list[float]:
+        """One leg's six angles for r = hip - ankle (root frame); the foot flat, turned by gamma (rad)
+        from the root's x axis (the hip yaw joint's turn, toe outward positive on either leg)."""
         s = SIDE_SIGN[side]
+        if gamma != 0.0:  # r in the foot's frame; the hip yaw joint turns the rest of the leg
+            c, sn = math.cos(gamma), math.sin(gamma)
+            rx, ry = c * rx + sn * ry, -sn * rx + c * ry
         l1, l2 = self.l1, self.l2
         cos_knee = (rx * rx + ry * ry + rz * rz - l1 * l1 - l2 * l2) / (2 * l1 * l2)
         knee = math.acos(min(1.0, max(-1.0, cos_knee)))
@@ -40,11 +48,17 @@ class FlatFootBody:
         vz = math.copysign(math.hypot(ry, rz), rz)
         a5 = -math.atan2(l1 * math.sin(knee), l1 * math.cos(knee) + l2) - math.atan2(rx, vz)
         # flat foot, no yaw: hip rotation Rx(-a6) Ry(-(knee + a5)): yaw 0, roll -a6, pitch -(knee + a5)
-        return [0.0, -s * a6, knee + a5, knee, -a5, s * a6]
+        return [s * gamma, -s * a6, knee + a5, knee, -a5, s * a6]
 
     def link_points(self, side: str, q: list[float]) -> list[tuple[float, float, float]]:
-        """Each leg link's CoM (root frame) for that leg's angles q (hip yaw 0)."""
-        return self._leg(side, q)[0]
+        """Each leg link's CoM (root frame) for that leg's angles q (hip yaw turning them about the hip)."""
+        points = self._leg(side, q)[0]
+        if q[0] == 0.0:
+            return points
+        gamma = SIDE_SIGN[side] * q[0]
+        c, sn = math.cos(gamma), math.sin(gamma)
+        hx, hy, _ = self.hips[side]
+        return [(hx + c * (px - hx) - sn * (py - hy), hy + sn * (px - hx) + c * (py - hy), pz) for px, py, pz in points]
 
     def _leg(self, side: str, q: list[float]):
         """(link CoMs, knee point, ankle point) in the root frame."""
@@ -104,14 +118,35 @@ class FlatFootBody:
                 out.append(-(mx * axes[j][0] + my * axes[j][1]))
         return out
 
-    def legs(self, root, ankles) -> list[float]:
-        """12 angles for an upright root at ``root`` (x, y, z) and flat feet at ankles[side index]."""
+    def legs(self, root, ankles, yaws=None) -> list[float]:
+        """12 angles for an upright root at ``root`` (x, y, z) and flat feet at ankles[side index], turned
+        by yaws[side index] (rad; the torso by their mean)."""
         q = []
+        if yaws is None or (yaws[0] == 0.0 and yaws[1] == 0.0):
+            for i, side in enumerate(SIDES):
+                hx, hy, hz = self.hips[side]
+                ax, ay, az = ankles[i]
+                q += self.leg_ik(side, root[0] + hx - ax, root[1] + hy - ay, root[2] + hz - az)
+            return q
+        psi = 0.5 * (yaws[0] + yaws[1])
+        c, sn = math.cos(psi), math.sin(psi)
         for i, side in enumerate(SIDES):
             hx, hy, hz = self.hips[side]
-            ax, ay, az = ankles[i]
-            q += self.leg_ik(side, root[0] + hx - ax, root[1] + hy - ay, root[2] + hz - az)
+            dx, dy = ankles[i][0] - root[0], ankles[i][1] - root[1]
+            q += self.leg_ik(side, hx - (c * dx + sn * dy), hy - (-sn * dx + c * dy), root[2] + hz - ankles[i][2],
+                             yaws[i] - psi)
         return q
+
+    def world_points(self, root, q, yaws=None) -> list[tuple[float, float, float]]:
+        """The torso's and the 12 leg links' CoMs in the world (the torso turned by the feet's mean yaw)."""
+        local = [self.torso_com]
+        for k, side in enumerate(SIDES):
+            local += self.link_points(side, q[6 * k:6 * k + 6])
+        psi = 0.0 if yaws is None else 0.5 * (yaws[0] + yaws[1])
+        if psi == 0.0:
+            return [(root[0] + p[0], root[1] + p[1], root[2] + p[2]) for p in local]
+        c, sn = math.cos(psi), math.sin(psi)
+        return [(root[0] + c * p[0] - sn * p[1], root[1] + sn * p[0] + c * p[1], root[2] + p[2]) for p in local]
 
     def com_in_root(self, q) -> tuple[float, float, float]:
         m = self.torso_kg
@@ -124,17 +159,21 @@ class FlatFootBody:
         return x / self.total_kg, y / self.total_kg, z / self.total_kg
 
     def place(self, com_x: float, com_y: float, ankles, root_z: float, guess_dx: float, guess_dy: float,
-              slope: float, tolerance_m: float, max_iterations: int):
+              slope: float, tolerance_m: float, max_iterations: int, yaws=None):
         """Root (x, y, z), angles and residual putting the whole CoM at (com_x, com_y) (as
-        gaitbot.gait.balance.placement.WholeBody.place, one frame)."""
+        gaitbot.gait.balance.placement.WholeBody.place, one frame; yaws: the feet's, rad)."""
+        psi = 0.0 if yaws is None else 0.5 * (yaws[0] + yaws[1])
+        c, sn = math.cos(psi), math.sin(psi)
         rx, ry = com_x + guess_dx, com_y + guess_dy
         sx = sy = slope
         last = None
         residual = math.inf
         q: list[float] = []
         for _ in range(max_iterations):
-            q = self.legs((rx, ry, root_z), ankles)
+            q = self.legs((rx, ry, root_z), ankles, yaws)
             cx, cy, _ = self.com_in_root(q)
+            if psi != 0.0:
+                cx, cy = c * cx - sn * cy, sn * cx + c * cy
             cx, cy = rx + cx, ry + cy
             ex, ey = com_x - cx, com_y - cy
             residual = max(abs(ex), abs(ey))

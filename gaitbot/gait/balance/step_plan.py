@@ -29,7 +29,12 @@ RISE_S = 0.4  # straight legs (all joints 0) <-> standing with STAND_KNEE_DEG, b
 STAND_KNEE_DEG = 10.0  # standing knees: bent this much, so the legs reach wherever the CoM puts the root
 START_PAUSE_S = 0.3
 END_STAND_S = 1.0
-PLAN_KEYS = ("zmp", "ankles", "root_z", "share_left", "cops", "swinging")
+PLAN_KEYS = ("zmp", "ankles", "root_z", "share_left", "cops", "swinging", "yaw")
+YAW_WINDOW = (0.05, 0.7)
+"""The swing foot turns while its ankle point goes from 5% to 70% of the way to its foothold (the yaw a
+smootherstep of that share: zero yaw rate and acceleration at lift-off and touch-down, and none while the
+sole leaves or meets the floor). Tying the turn to the position (not to time) makes the swing's path in
+the plane one curve, whatever the step's timing: the planner checks the feet's clearance along it."""
 
 
 def feedforward_weight(frame, last_frame: float, rate_hz: float):
@@ -40,6 +45,28 @@ def feedforward_weight(frame, last_frame: float, rate_hz: float):
     frame = np.asarray(frame, dtype=float)
     n = SETTLE_S * rate_hz
     return np.minimum(smootherstep(frame / n), smootherstep((last_frame - frame) / n))
+
+
+STEERED_PROGRESSION_END = 0.6
+ASIDE_M = 0.015
+"""A swing that goes backward, or more than ASIDE_M sideways (in the stance foot's frame), is over its
+foothold by 60% of the swing (others: [balance] progression_end): soft servos lag, and a foot still
+travelling back or aside when it comes down lands short (on the Menagerie OP3 backward steps land 85% of
+their length with 0.85, 89% with 0.6, and sidesteps turn the robot 5 deg per 0.3 m: docs/steering.md)."""
+
+
+def back_or_aside(stance: FootPlacement, old: FootPlacement, new: FootPlacement) -> bool:
+    """Whether the swing from ``old`` to ``new`` goes backward or aside (ASIDE_M), in the stance's frame."""
+    c, s = math.cos(stance.yaw_rad), math.sin(stance.yaw_rad)
+    dx, dy = new.x_m - old.x_m, new.y_m - old.y_m
+    return c * dx + s * dy < 0.0 or abs(-s * dx + c * dy) > ASIDE_M
+
+
+def swing_yaw_share(position_share):
+    """The share of its turn the swing foot has made when its ankle point is ``position_share`` of the way
+    to its foothold (0 -> 1 over YAW_WINDOW)."""
+    a, b = YAW_WINDOW
+    return smootherstep((np.asarray(position_share, dtype=float) - a) / (b - a))
 
 
 def crouch_hip_height_m(geometry: BodyGeometry, knee_deg: float) -> float:
@@ -73,8 +100,10 @@ class PlanBlocks:
     share_left: list = field(default_factory=list)
     cops: list = field(default_factory=list)
     swinging: list = field(default_factory=list)
+    yaw: list = field(default_factory=list)
 
-    def add(self, zmp, ankles, root_z, share_left, cops, swinging) -> None:
+    def add(self, zmp, ankles, root_z, share_left, cops, swinging, yaw=(0.0, 0.0)) -> None:
+        """One block of n frames; yaw: each foot's yaw (rad), (2,) held or (n, 2)."""
         n = len(zmp)
         self.zmp.append(np.asarray(zmp, dtype=float).reshape(n, 2))
         self.ankles.append(np.asarray(ankles, dtype=float).reshape(n, 2, 3))
@@ -82,6 +111,7 @@ class PlanBlocks:
         self.share_left.append(np.broadcast_to(np.asarray(share_left, dtype=float), (n,)).copy())
         self.cops.append(np.asarray(cops, dtype=float).reshape(n, 2, 2))
         self.swinging.append(np.broadcast_to(np.asarray(swinging), (n,)).astype(np.int8))
+        self.yaw.append(np.broadcast_to(np.asarray(yaw, dtype=float), (n, 2)).copy())
 
     @property
     def frames(self) -> int:
@@ -101,6 +131,7 @@ class Landing:
     ankle_y_m: float
     length_m: float
     start_frame: int
+    yaw_rad: float = 0.0
 
 
 class StepPlanner:
@@ -118,8 +149,11 @@ class StepPlanner:
         self.walk_root_z = crouch_hip_height_m(g, balance.crouch_knee_deg) + g.ankle_height_m + g.hip_below_root_m
 
     def start_feet(self) -> dict:
+        return self.start_feet_of(self.geometry)
+
+    @staticmethod
+    def start_feet_of(g: BodyGeometry) -> dict:
         """Both heels at x = 0 (the planar walker's origin), ankles hip_width apart."""
-        g = self.geometry
         return {side: FootPlacement(side, g.heel_back_m, SIDE_SIGN[side] * g.hip_width_m / 2) for side in SIDES}
 
     def start(self) -> PlanState:
@@ -133,9 +167,12 @@ class StepPlanner:
     def cops(self, feet: dict) -> np.ndarray:
         return np.array([zmp_point(self.geometry, self.balance, feet[s]) for s in SIDES])
 
+    def yaws(self, feet: dict) -> np.ndarray:
+        return np.array([feet[s].yaw_rad for s in SIDES])
+
     def _still(self, blocks: PlanBlocks, state: PlanState, n: int, root_z) -> None:
         blocks.add(np.repeat(state.zmp_now[None], n, 0), np.repeat(self.ankles(state.feet)[None], n, 0), root_z,
-                   state.share_left, np.repeat(self.cops(state.feet)[None], n, 0), 0)
+                   state.share_left, np.repeat(self.cops(state.feet)[None], n, 0), 0, self.yaws(state.feet))
 
     def settle(self, blocks: PlanBlocks, state: PlanState, bend: bool) -> None:
         """Stand -> walking crouch (bend) or back, in SETTLE_S."""
@@ -149,26 +186,39 @@ class StepPlanner:
         self._still(blocks, state, round(seconds * self.timing.rate_hz), self.walk_root_z)
 
     def step(self, blocks: PlanBlocks, state: PlanState, length_m: float) -> Landing:
+        """A straight step: the swing foot lands ``length_m`` ahead of the stance foot, hip_width from the
+        midline (seed 000's step length, heel strike to heel strike)."""
+        stance = state.feet[state.stance_next]
+        swing_side = "right" if state.stance_next == "left" else "left"
+        new = FootPlacement(swing_side, stance.x_m + length_m, SIDE_SIGN[swing_side] * self.geometry.hip_width_m / 2)
+        return self.step_to(blocks, state, new, length_m)
+
+    def step_to(self, blocks: PlanBlocks, state: PlanState, new: FootPlacement, length_m: float) -> Landing:
         """Double support (the ZMP moves to the stance foot), then single support (the other foot swings
-        along the planar Boulic swing's shape, scaled to this step, landing exactly on its foothold)."""
+        along the planar Boulic swing's shape, scaled to this step, turning to its new yaw inside
+        YAW_WINDOW, landing exactly on its foothold ``new``)."""
         g, t, b = self.geometry, self.timing, self.balance
         start_frame = blocks.frames
         stance_side = state.stance_next
         swing_side = "right" if stance_side == "left" else "left"
+        if new.side != swing_side:
+            raise ValueError(f"the next step is the {swing_side} foot's, not the {new.side} foot's")
         stance, old = state.feet[stance_side], state.feet[swing_side]
-        new = FootPlacement(swing_side, stance.x_m + length_m, SIDE_SIGN[swing_side] * g.hip_width_m / 2)
-        feet_ankles, feet_cops = self.ankles(state.feet), self.cops(state.feet)
+        feet_ankles, feet_cops, feet_yaw = self.ankles(state.feet), self.cops(state.feet), self.yaws(state.feet)
         n_ds = t.step_frames if state.steps == 0 else t.ds_frames  # the first: the weight shift
         target = zmp_point(g, b, stance)
         zmp, w = shift(state.zmp_now, target, n_ds)
         share_target = 1.0 if stance_side == "left" else 0.0
         blocks.add(zmp, np.repeat(feet_ankles[None], n_ds, 0), self.walk_root_z,
-                   state.share_left + w * (share_target - state.share_left), np.repeat(feet_cops[None], n_ds, 0), 0)
+                   state.share_left + w * (share_target - state.share_left), np.repeat(feet_cops[None], n_ds, 0), 0,
+                   feet_yaw)
         n_ss = t.ss_frames
-        progression, lift = self.swing.at(abs(new.x_m - old.x_m))
+        progression, lift = self.swing.at(math.hypot(new.x_m - old.x_m, new.y_m - old.y_m))
+        progression_end = min(b.progression_end, STEERED_PROGRESSION_END) if back_or_aside(stance, old, new) \
+            else b.progression_end
         peak = self.swing.peak_for_clearance(lift, self.clearance_m)
         tau = np.arange(1, n_ss + 1) / n_ss
-        p = np.interp(np.minimum(tau / b.progression_end, 1.0), self.swing.tau, progression)
+        p = np.interp(np.minimum(tau / progression_end, 1.0), self.swing.tau, progression)
         h = peak * np.interp(tau, self.swing.tau, lift)
         ankles = np.repeat(feet_ankles[None], n_ss, 0)
         i = SIDES.index(swing_side)
@@ -176,28 +226,49 @@ class StepPlanner:
         ankles[:, i, 1] = old.y_m + p * (new.y_m - old.y_m)
         ankles[:, i, 2] = g.ankle_height_m + h
         ankles[-1, i] = [new.x_m, new.y_m, g.ankle_height_m]  # lands exactly on its foothold
+        yaw = np.repeat(feet_yaw[None], n_ss, 0)
+        yaw[:, i] = old.yaw_rad + swing_yaw_share(p) * (new.yaw_rad - old.yaw_rad)
+        yaw[-1, i] = new.yaw_rad
         cops = np.repeat(feet_cops[None], n_ss, 0)
-        cops[:, i] += ankles[:, i, :2] - feet_ankles[i, :2]  # the swing foot's point goes with it
-        blocks.add(np.repeat(target[None], n_ss, 0), ankles, self.walk_root_z, share_target, cops, 1 + i)
+        cops[:, i] += ankles[:, i, :2] - feet_ankles[i, :2]  # the swing foot's point goes with it (it bears no load)
+        blocks.add(np.repeat(target[None], n_ss, 0), ankles, self.walk_root_z, share_target, cops, 1 + i, yaw)
         state.feet[swing_side] = new
         state.zmp_now = target
         state.share_left = share_target
         state.stance_next = swing_side
         state.steps += 1
         state.last_length_m = length_m
-        return Landing(blocks.frames - 1, swing_side, new.x_m, new.y_m, length_m, start_frame)
+        return Landing(blocks.frames - 1, swing_side, new.x_m, new.y_m, length_m, start_frame, new.yaw_rad)
+
+    def partner(self, stance: FootPlacement) -> FootPlacement:
+        """The other foot side by side with ``stance``: parallel, ankles hip_width apart."""
+        side = "right" if stance.side == "left" else "left"
+        x, y = stance.to_world(0.0, SIDE_SIGN[side] * self.geometry.hip_width_m)
+        return FootPlacement(side, float(x), float(y), stance.yaw_rad)
+
+    def side_by_side(self, state: PlanState) -> bool:
+        """Whether the feet stand side by side (the last swing foot where ``partner`` puts it)."""
+        last = state.feet["right" if state.stance_next == "left" else "left"]
+        other = self.partner(state.feet[state.stance_next])
+        return abs(last.x_m - other.x_m) < 1e-12 and abs(last.y_m - other.y_m) < 1e-12 and \
+            abs(last.yaw_rad - other.yaw_rad) < 1e-12
 
     def close(self, blocks: PlanBlocks, state: PlanState) -> list[Landing]:
         """Close the trailing foot beside the leading one (unless it is already), move the ZMP back
         between the feet, stand still for the preview to settle, and stand up."""
         landings = []
-        if state.steps == 0 or state.last_length_m != 0.0:
+        half = self.geometry.hip_width_m / 2
+        turned = any(f.yaw_rad != 0.0 or f.y_m != SIDE_SIGN[f.side] * half for f in state.feet.values())
+        if not turned and (state.steps == 0 or state.last_length_m != 0.0):
             landings.append(self.step(blocks, state, 0.0))
+        elif turned and (state.steps == 0 or not self.side_by_side(state)):
+            landings.append(self.step_to(blocks, state, self.partner(state.feet[state.stance_next]), 0.0))
         middle = standing_zmp(self.geometry, state.feet["left"], state.feet["right"])
         zmp, w = shift(state.zmp_now, middle, self.timing.step_frames)
         n = len(zmp)
         blocks.add(zmp, np.repeat(self.ankles(state.feet)[None], n, 0), self.walk_root_z,
-                   state.share_left + w * (0.5 - state.share_left), np.repeat(self.cops(state.feet)[None], n, 0), 0)
+                   state.share_left + w * (0.5 - state.share_left), np.repeat(self.cops(state.feet)[None], n, 0), 0,
+                   self.yaws(state.feet))
         state.zmp_now, state.share_left = middle, 0.5
         self.hold(blocks, state, END_STAND_S)
         self.settle(blocks, state, bend=False)

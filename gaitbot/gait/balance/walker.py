@@ -31,13 +31,13 @@ import numpy as np
 
 from gaitbot.gait.balance.flat_frame import FlatFootBody
 from gaitbot.gait.balance.placement import (MAX_PLACEMENT_ITERATIONS, PLACEMENT_TOLERANCE_M, WholeBody,
-                                            multibody_zmp)
+                                            multibody_zmp, to_world, torso_yaw)
 from gaitbot.gait.balance.preview import PreviewController, preview_gains, preview_offline
 from gaitbot.gait.balance.settings import BalanceSettings
 from gaitbot.gait.balance.step_plan import (RISE_S, START_PAUSE_S, Landing, PlanBlocks, StepPlanner,
                                            feedforward_weight)
 from gaitbot.gait.balance.swing import swing_shapes
-from gaitbot.gait.balance.zmp_reference import Timing, smootherstep
+from gaitbot.gait.balance.zmp_reference import FootPlacement, Timing, smootherstep
 from gaitbot.gait.body import SIDE_SIGN, BodyModel
 from gaitbot.gait.geometry import LegGeometry
 from gaitbot.gait.joints import LEG_JOINTS
@@ -97,11 +97,22 @@ class BalancedWalk:
     heel_strikes: tuple[HeelStrike, ...]
     planned_steps: tuple[PlannedStep, ...]
     residual_m: float
+    yaw_rad: np.ndarray | None = None  # (n, 2) each foot's yaw where the walk turns; None: straight
+
+    @property
+    def torso_yaw_rad(self) -> np.ndarray:
+        """The torso's yaw over frames (the mean of the feet's; zeros for a straight walk)."""
+        return np.zeros(len(self.t_s)) if self.yaw_rad is None else torso_yaw(self.yaw_rad)
 
     def trajectory(self, goals: bool = False) -> Trajectory:
-        """The planned angles (exact kinematics), or with ``goals`` the angles the servos are sent."""
+        """The planned angles (exact kinematics), or with ``goals`` the angles the servos are sent; a turning
+        walk carries the torso's yaw (trajectory format 2's torso_yaw_deg)."""
+        rpy = None
+        if self.yaw_rad is not None:
+            rpy = np.zeros((len(self.t_s), 3))
+            rpy[:, 2] = self.torso_yaw_rad
         return Trajectory(self.t_s, self.goals_rad if goals else self.q_rad, self.root_m, self.heel_strikes,
-                          LEG_JOINTS)
+                          LEG_JOINTS, rpy)
 
 
 def leg_of(body: BodyModel) -> LegGeometry:
@@ -180,6 +191,38 @@ class BalancedWalker:
             if self._primed:
                 self._replan_lookahead()
 
+    def append_footstep(self, foothold: FootPlacement, length_m: float = 0.0) -> None:
+        """Queue one steered step: the next swing foot (``next_swing_side``) lands at ``foothold`` (its
+        ankle point and yaw, world); ``length_m`` is recorded as the step's length (its forward part).
+        The planner (gaitbot.gait.steer.planner) has bounded it and checked the feet's clearance."""
+        if self.finished:
+            raise RuntimeError("the walk has already been closed; start a new walker")
+        if not all(math.isfinite(v) for v in (foothold.x_m, foothold.y_m, foothold.yaw_rad, length_m)):
+            raise BalancedWalkError(f"foothold {foothold!r} is not finite")
+        self._record(self.planner.step_to(self._blocks, self._state, foothold, float(length_m)), closing=False)
+        if not self._batch:
+            self._commit()
+            if self._primed:
+                self._replan_lookahead()
+
+    def lead_with(self, side: str) -> None:
+        """Make ``side`` the first foot to swing (a sidestep or a turn leads with the foot on its side)."""
+        if self.planned_steps:
+            raise RuntimeError("the first step is already planned")
+        self._state.stance_next = "right" if side == "left" else "left"
+        if not self._batch:
+            self._commit()
+
+    @property
+    def next_swing_side(self) -> str:
+        """The foot the next queued step swings."""
+        return "right" if self._state.stance_next == "left" else "left"
+
+    @property
+    def feet(self) -> dict:
+        """Where each foot stands after the steps queued so far (side -> FootPlacement)."""
+        return dict(self._state.feet)
+
     def finish(self) -> None:
         """Close the trailing foot beside the leading one, move the weight between the feet and stand."""
         if self.finished:
@@ -194,26 +237,32 @@ class BalancedWalker:
         """(roots, angles) of the rise from straight legs that comes before the balance plan."""
         return self._rise
 
-    def straight_path(self, root_m, ankles, rising: bool) -> tuple[np.ndarray, np.ndarray]:
+    def straight_path(self, root_m, ankles, rising: bool, yaw=None) -> tuple[np.ndarray, np.ndarray]:
         """(roots (n, 3), angles (n, 12)) between straight legs over ``ankles`` (both feet flat, every joint
         0) and the pose whose root is ``root_m``: rising, from straight up to just before that pose;
         else from just after it down to straight. The pelvis moves on a straight line (smootherstep in
         time), the legs by the IK: the feet stay exactly where they are."""
         g = self.body.geometry
-        straight = np.array([ankles[:, 0].mean(), 0.0, g.standing_root_height_m])
+        straight = np.array([ankles[:, 0].mean(), ankles[:, 1].mean(), g.standing_root_height_m])
         n = self.rise_frames
         tau = np.arange(n) / n if rising else np.arange(1, n + 1) / n
         w = smootherstep(tau)[:, None]
         roots = (straight + w * (root_m - straight)) if rising else (root_m + w * (straight - root_m))
-        q = self.whole.legs(roots, np.repeat(np.asarray(ankles)[None], n, 0))
+        yaws = None if yaw is None or not np.any(yaw) else np.repeat(np.asarray(yaw, dtype=float)[None], n, 0)
+        q = self.whole.legs(roots, np.repeat(np.asarray(ankles)[None], n, 0), yaws)
         q[0 if rising else -1] = 0.0  # exactly the servos' standing pose
         return roots, q
 
     def _record(self, landing: Landing, closing: bool) -> None:
         g = self.body.geometry
         t = (landing.frame + self.rise_frames) / self.rate_hz
-        heel_x = landing.ankle_x_m - g.heel_back_m
-        sole_y = landing.ankle_y_m + SIDE_SIGN[landing.side] * g.sole_outward_m
+        foot = FootPlacement(landing.side, landing.ankle_x_m, landing.ankle_y_m, landing.yaw_rad)
+        if landing.yaw_rad != 0.0:
+            heel_x = float(foot.to_world(-g.heel_back_m, 0.0)[0])
+            sole_y = float(foot.to_world(0.0, SIDE_SIGN[landing.side] * g.sole_outward_m)[1])
+        else:
+            heel_x = landing.ankle_x_m - g.heel_back_m
+            sole_y = landing.ankle_y_m + SIDE_SIGN[landing.side] * g.sole_outward_m
         self.heel_strikes.append(HeelStrike(t, landing.side, heel_x, sole_y))
         self.planned_steps.append(PlannedStep(len(self.planned_steps) + 1, landing.side, landing.length_m, None,
                                               (landing.start_frame + self.rise_frames) / self.rate_hz, t, heel_x,
@@ -275,17 +324,14 @@ class BalancedWalker:
             com = self._stage1.state[0].copy()
             self._stage1.step(self._zmp_padded[i], self._zmp_padded[i + 1:i + 1 + horizon])
             guess = _extrapolated(self._s1_offset, self._s1_offsets.get(i - 2))
+            yaws = self._yaws_at(i)
             root, q, _ = flat.place(com[0], com[1], self._ext_at("ankles", i), float(self._ext_at("root_z", i)),
-                                    guess[0], guess[1], self.com_slope, PLACEMENT_TOLERANCE_M, MAX_PLACEMENT_ITERATIONS)
+                                    guess[0], guess[1], self.com_slope, PLACEMENT_TOLERANCE_M, MAX_PLACEMENT_ITERATIONS,
+                                    yaws)
             self._s1_offset = (root[0] - com[0], root[1] - com[1])
             self._s1_offsets[i] = self._s1_offset
             self._s1_com[i] = com
-            c = flat.torso_com
-            points = [(root[0] + c[0], root[1] + c[1], root[2] + c[2])]
-            for k, side in enumerate(("left", "right")):
-                points += [(root[0] + p[0], root[1] + p[1], root[2] + p[2])
-                           for p in flat.link_points(side, q[6 * k:6 * k + 6])]
-            self._s1_points[i] = np.array(points)
+            self._s1_points[i] = np.array(flat.world_points(root, q, yaws))
             self._s1_next += 1
 
     def _replan_lookahead(self) -> None:
@@ -308,8 +354,10 @@ class BalancedWalker:
         coms = np.array(coms)
         idx = np.minimum(np.arange(k, end + 1), len(self._ext["zmp"]) - 1)
         guess = np.array([self._s1_offsets.get(i, self._s1_offset) for i in frames])
-        root, q, _ = self.whole.place(coms, self._ext["ankles"][idx], self._ext["root_z"][idx], guess, self.com_slope)
-        points = self.whole.link_points(root, q)
+        yaw = self._ext["yaw"][idx] if self._ext["yaw"][idx].any() else None
+        root, q, _ = self.whole.place(coms, self._ext["ankles"][idx], self._ext["root_z"][idx], guess, self.com_slope,
+                                      yaw)
+        points = self.whole.link_points(root, q, yaw)
         for n, i in enumerate(frames):
             self._s1_com[i] = coms[n]
             self._s1_points[i] = points[n]
@@ -350,8 +398,9 @@ class BalancedWalker:
             frame = self._balance_frame()
             if frame is None:
                 if self._lower is None:
-                    self._lower = self.straight_path(self._last_root, self._ext["ankles"][self._committed - 1],
-                                                     rising=False)
+                    last = self._committed - 1
+                    self._lower = self.straight_path(self._last_root, self._ext["ankles"][last], rising=False,
+                                                     yaw=self._ext["yaw"][last])
                 i = j - self.rise_frames - self._committed
                 if i >= self.rise_frames:
                     return None
@@ -385,24 +434,42 @@ class BalancedWalker:
         com = self._s1_com[k] + correction
         flat = self._flat
         guess = _extrapolated(self._offset, self._previous_offset)
+        yaws = self._yaws_at(k)
         root, q, _ = flat.place(com[0], com[1], self._ext_at("ankles", k), float(self._ext_at("root_z", k)),
-                                guess[0], guess[1], self.com_slope, PLACEMENT_TOLERANCE_M, MAX_PLACEMENT_ITERATIONS)
+                                guess[0], guess[1], self.com_slope, PLACEMENT_TOLERANCE_M, MAX_PLACEMENT_ITERATIONS,
+                                yaws)
         self._previous_offset = self._offset
         self._offset = (root[0] - com[0], root[1] - com[1])
         for cache in (self._s1_com, self._s1_points, self._s1_snapshot, self._s1_offsets):  # drop the past
             cache.pop(k - 2, None)
         goal = q
         if self.feedforward:
-            cops = self._arrays["cops"][k]
-            torque = flat.gravity_torques(q, smoothed_share(self._ext["share_left"], self.rate_hz, k),
-                                          ((cops[0, 0] - root[0], cops[0, 1] - root[1]),
-                                           (cops[1, 0] - root[0], cops[1, 1] - root[1])))
+            torque = self._gravity_torques(q, root, k, yaws)
             last = self._committed - 1 if self.finished else math.inf
             w = float(feedforward_weight(k, last, self.rate_hz))
             goal = [a + w * t / kp for a, t, kp in zip(q, torque, self.kp_nm_per_rad)]
         self._k += 1
         self._last_root = np.array(root)
         return np.array(q), np.array(goal), np.array(root)
+
+    def _yaws_at(self, i: int):
+        """The feet's yaws at plan frame i as floats, or None where both are 0 (the straight walk's code)."""
+        yaw = self._ext_at("yaw", i)
+        return None if yaw[0] == 0.0 and yaw[1] == 0.0 else (float(yaw[0]), float(yaw[1]))
+
+    def _gravity_torques(self, q, root, k: int, yaws):
+        """The sag feedforward's joint torques at plan frame k (the float code; turned feet: the mass model's,
+        with the feet's centres of pressure in the turned torso's frame)."""
+        cops = self._arrays["cops"][k]
+        share = smoothed_share(self._ext["share_left"], self.rate_hz, k)
+        if yaws is None:
+            return self._flat.gravity_torques(q, share, ((cops[0, 0] - root[0], cops[0, 1] - root[1]),
+                                                         (cops[1, 0] - root[0], cops[1, 1] - root[1])))
+        psi = 0.5 * (yaws[0] + yaws[1])
+        c, sn = math.cos(psi), math.sin(psi)
+        local = [(c * (x - root[0]) + sn * (y - root[1]), -sn * (x - root[0]) + c * (y - root[1]), -root[2])
+                 for x, y in cops]
+        return list(self.whole.mass.gravity_torques(np.array(q), share, local[0], local[1]))
 
 
 def _extrapolated(offset, previous) -> tuple[float, float]:
@@ -418,8 +485,13 @@ def plan_balanced_walk(body: BodyModel, step_lengths, gait: BalancedGaitSettings
     """A closed walker with every step queued (nothing computed past the plan yet)."""
     walker = BalancedWalker(body, gait, balance, **options)
     walker._batch = True
-    for length in step_lengths:
-        walker.append_step(length)
+    for step in step_lengths:  # a length (m), or a steered step (gaitbot.gait.steer.planner.Footstep)
+        if hasattr(step, "foothold"):
+            if not walker.planned_steps and step.foothold.side != walker.next_swing_side:
+                walker.lead_with(step.foothold.side)
+            walker.append_footstep(step.foothold, step.length_m)
+        else:
+            walker.append_step(step)
     walker._batch = False
     walker.finish()
     return walker
@@ -440,20 +512,21 @@ def walk_of(walker: BalancedWalker) -> BalancedWalk:
     whole, gains = walker.whole, walker.gains
     n = len(a["zmp"])
     dt = 1.0 / walker.rate_hz
+    yaw = a["yaw"] if a["yaw"].any() else None
     com1 = preview_offline(gains, a["zmp"])  # first stage: the cart-table's CoM for the ZMP reference
-    root1, q1, _ = whole.place(com1, a["ankles"], a["root_z"], walker.standing_offset, walker.com_slope)
-    points = whole.link_points(root1, q1)  # second stage: preview the multibody ZMP's error
+    root1, q1, _ = whole.place(com1, a["ankles"], a["root_z"], walker.standing_offset, walker.com_slope, yaw)
+    points = whole.link_points(root1, q1, yaw)  # second stage: preview the multibody ZMP's error
     error = multibody_zmp(np.concatenate([points[:1], points, points[-1:]]), whole.point_masses_kg, dt) - a["zmp"]
     com_xy = com1 + preview_offline(gains, -error, com_xy0=np.zeros(2))
-    root, q, residual = whole.place(com_xy, a["ankles"], a["root_z"], walker.standing_offset, walker.com_slope)
+    root, q, residual = whole.place(com_xy, a["ankles"], a["root_z"], walker.standing_offset, walker.com_slope, yaw)
     goals = q
     if walker.feedforward:
         w = feedforward_weight(np.arange(n), n - 1, walker.rate_hz)[:, None]
         share = smoothed_share(a["share_left"], walker.rate_hz)
-        goals = q + w * (whole.sag_goals(q, share, a["cops"], root, walker.kp_nm_per_rad) - q)
+        goals = q + w * (whole.sag_goals(q, share, a["cops"], root, walker.kp_nm_per_rad, yaw) - q)
     # the rise from straight legs before the balance plan, and the way back down after it
     rise_root, rise_q = walker.rise_path
-    lower_root, lower_q = walker.straight_path(root[-1], a["ankles"][-1], rising=False)
+    lower_root, lower_q = walker.straight_path(root[-1], a["ankles"][-1], rising=False, yaw=a["yaw"][-1])
     m = walker.rise_frames
 
     def framed(before, middle, after):
@@ -467,11 +540,13 @@ def walk_of(walker: BalancedWalker) -> BalancedWalk:
     ankles = framed(np.repeat(a["ankles"][:1], m, 0), a["ankles"], np.repeat(a["ankles"][-1:], m, 0))
     zmp_ref = framed(np.repeat(a["zmp"][:1], m, 0), a["zmp"], np.repeat(a["zmp"][-1:], m, 0))
     swinging = framed(np.zeros(m, np.int8), a["swinging"], np.zeros(m, np.int8))
-    com = root + whole.mass.com_in_root(q)
-    points = whole.link_points(root, q)
+    if yaw is not None:
+        yaw = framed(np.repeat(yaw[:1], m, 0), yaw, np.repeat(yaw[-1:], m, 0))
+    com = root + to_world(whole.mass.com_in_root(q), yaw)
+    points = whole.link_points(root, q, yaw)
     zmp_plan = multibody_zmp(np.concatenate([points[:1], points, points[-1:]]), whole.point_masses_kg, dt)
     return BalancedWalk(np.arange(len(q)) / walker.rate_hz, q, goals, root, com, zmp_ref, zmp_plan, ankles,
-                        swinging, tuple(walker.heel_strikes), tuple(walker.planned_steps), residual)
+                        swinging, tuple(walker.heel_strikes), tuple(walker.planned_steps), residual, yaw)
 
 
 def _check_limits(walker: BalancedWalker, q) -> None:

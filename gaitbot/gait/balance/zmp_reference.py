@@ -14,6 +14,7 @@ towards the midline: a point well inside the sole, away from the edges the robot
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,21 +58,33 @@ class Timing:
 
 @dataclass(frozen=True)
 class FootPlacement:
-    """Where a foot's ankle point stands (world x, y in metres; the sole flat on the floor, toe ahead)."""
+    """Where a foot's ankle point stands (world x, y in metres; the sole flat on the floor) and which way
+    its toe points (yaw_rad, counter-clockwise from the world's x axis; 0: straight ahead)."""
 
     side: str
     x_m: float
     y_m: float
+    yaw_rad: float = 0.0
+
+    def to_world(self, forward_m: float, left_m: float) -> np.ndarray:
+        """A point given in the foot's frame (forward, left of the ankle point) in the world (x, y)."""
+        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
+        return np.array([self.x_m + c * forward_m - s * left_m, self.y_m + s * forward_m + c * left_m])
 
 
 def sole_centre_xy(geometry: BodyGeometry, foot: FootPlacement) -> np.ndarray:
     s = SIDE_SIGN[foot.side]
+    if foot.yaw_rad != 0.0:
+        return foot.to_world(geometry.foot_m / 2 - geometry.heel_back_m, s * geometry.sole_outward_m)
     return np.array([foot.x_m + geometry.foot_m / 2 - geometry.heel_back_m, foot.y_m + s * geometry.sole_outward_m])
 
 
 def zmp_point(geometry: BodyGeometry, balance: BalanceSettings, foot: FootPlacement) -> np.ndarray:
-    """The ZMP reference point (x, y) of a foot standing at ``foot``."""
+    """The ZMP reference point (x, y) of a foot standing at ``foot`` (offsets in the foot's own frame)."""
     s = SIDE_SIGN[foot.side]
+    if foot.yaw_rad != 0.0:
+        return foot.to_world(geometry.foot_m / 2 - geometry.heel_back_m + balance.zmp_forward_m,
+                             s * (geometry.sole_outward_m - balance.zmp_inward_m))
     return sole_centre_xy(geometry, foot) + np.array([balance.zmp_forward_m, -s * balance.zmp_inward_m])
 
 
