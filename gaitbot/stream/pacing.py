@@ -15,7 +15,7 @@ late against them.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -66,6 +66,9 @@ class StreamStats:
 
     def _record(self, lateness_s: float, bus_call_s: float) -> None:
         k = self.frames
+        if k >= len(self.lateness_s):  # frames from an iterator (a live drive): the arrays grow by doubling
+            self.lateness_s = np.concatenate([self.lateness_s, np.zeros(max(k, 1024))])
+            self.bus_call_s = np.concatenate([self.bus_call_s, np.zeros(max(k, 1024))])
         self.lateness_s[k] = lateness_s
         self.bus_call_s[k] = bus_call_s
         self.frames = k + 1
@@ -193,11 +196,17 @@ class Streamer:
         ``next_deadline_s`` holds the deadline after the last frame sent (also when interrupted).
         ``previous_send_s``: when the frame before this run went out (a session's previous run), so the
         pacing rule holds across runs too: a stop ramp never follows a late walk frame by less than
-        ``min_frame_interval_s``. ``last_send_s`` holds the send time of this run's last frame."""
-        frames = as_tick_frames(frames, len(self.ids))
-        count = frames.shape[0]
+        ``min_frame_interval_s``. ``last_send_s`` holds the send time of this run's last frame.
+
+        ``frames`` may also be an iterator of frames (a live drive, gaitbot.drive): each frame is taken
+        from it one at a time, just before its deadline, and the run ends when it is exhausted."""
+        if isinstance(frames, Iterator):
+            rows, count = _checked_rows(frames, len(self.ids)), None
+        else:
+            array = as_tick_frames(frames, len(self.ids))
+            rows, count = iter(array), array.shape[0]
         stats = StreamStats(period_s=self.period_s, late_threshold_s=self.late_threshold_s,
-                            lateness_s=np.zeros(count), bus_call_s=np.zeros(count))
+                            lateness_s=np.zeros(count or 1024), bus_call_s=np.zeros(count or 1024))
         self.stats = stats
         clock, bus, ids, cpu, monitor = self.clock, self.bus, self.ids, self.cpu_time_s, self.monitor
         cpu_start = cpu()
@@ -208,17 +217,23 @@ class Streamer:
             ticks = paced_deadlines(clock, self.period_s, start_s, self.min_frame_interval_s, earliest_s)
             last_write_s = previous_send_s
             min_interval_s = self.min_frame_interval_s
-            for _, (k, deadline_s, send_s) in zip(range(count), ticks):
+            while True:
                 work_cpu_start = cpu()
+                frame = next(rows, None)  # before the wait: a live frame's work does not delay its send
+                if frame is None:
+                    break
+                frame_cpu_s = cpu() - work_cpu_start
+                k, deadline_s, send_s = next(ticks)
+                work_cpu_start = cpu() - frame_cpu_s  # the wait is not work
                 # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
                 # time: converting a whole one-hour walk up front would take ~100 MB.
-                goals = dict(zip(ids, frames[k].tolist()))
+                goals = dict(zip(ids, frame.tolist()))
                 # The pacing rule on the wire itself: had the host paused between the previous frame's
                 # start and its write, this write still waits the minimum interval after that one.
                 if last_write_s is not None and clock.now() < last_write_s + min_interval_s:
                     clock.sleep_until(last_write_s + min_interval_s)
                 last_write_s = self.last_send_s = clock.now()
-                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frames[k]
+                self.previous_sent_ticks, self.last_sent_ticks = self.last_sent_ticks, frame
                 bus.write_goal_ticks(goals)
                 # The grid moves on as soon as the goals went out: whatever the read-back raises, the
                 # next frame sent (a stop ramp's first) is due one period after this one, not at once.
@@ -254,6 +269,12 @@ def paced_deadlines(clock: Clock, period_s: float, start_s: float, min_interval_
         yield k, deadline_s, work_s
         earliest_s = work_s + min_interval_s
         k += 1
+
+
+def _checked_rows(frames: Iterator, joint_count: int):
+    """The frames of an iterator, each checked as :func:`as_tick_frames` checks an array's."""
+    for frame in frames:
+        yield as_tick_frames(np.asarray(frame).reshape(1, -1), joint_count)[0]
 
 
 def as_tick_frames(frames: ArrayLike, joint_count: int) -> np.ndarray:

@@ -8,7 +8,8 @@ docs/bus-faults.md.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+import itertools
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -112,7 +113,7 @@ class SessionResult:
         return "; ".join(parts) + "."
 
 
-def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: ArrayLike, *,
+def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike | Iterator, stand_ticks: ArrayLike, *,
                  max_velocity_ticks_per_s: float, max_accel_ticks_per_s2: float,
                  period_s: float = 1 / 60, clock: Clock | None = None,
                  torque_off_on_exit: bool = False,
@@ -143,9 +144,7 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
     before torque goes on, so a robot already too hot or on a flat battery does not start.
     """
     ids = [int(i) for i in ids]
-    walk = as_tick_frames(frames, len(ids))
-    if walk.shape[0] == 0:
-        raise ValueError("frames is empty: nothing to walk")
+    walk, rest = _first_frames(frames, len(ids))
     stand = as_tick_frames(np.asarray(stand_ticks).reshape(1, -1), len(ids))[0]
     clock = clock if clock is not None else MonotonicClock()
 
@@ -189,8 +188,14 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
             state.next_deadline_s = first_sent_s + period_s
             if not at_start:
                 state.run(streamer(monitored=True), ramp(present, walk[0]))
-            state.run(streamer(on_frame, monitored=True), walk[1:] if at_start else walk, is_walk=True)
-            state.run(streamer(monitored=True), stop(walk[-2] if len(walk) > 1 else walk[-1], walk[-1]))
+            if rest is None:
+                state.run(streamer(on_frame, monitored=True), walk[1:] if at_start else walk, is_walk=True)
+                state.run(streamer(monitored=True), stop(walk[-2] if len(walk) > 1 else walk[-1], walk[-1]))
+            else:  # frames from an iterator (a live drive): the stop ramp starts from the last two sent
+                state.run(streamer(on_frame, monitored=True), rest if at_start else itertools.chain([walk[0]], rest),
+                          is_walk=True)
+                previous = state.previous_sent if state.previous_sent is not None else state.last_sent
+                state.run(streamer(monitored=True), stop(previous, state.last_sent))
             outcome, error = "completed", None
         except (KeyboardInterrupt, Terminated) as exc:
             outcome, error = ("terminated" if isinstance(exc, Terminated) else "interrupted"), None
@@ -227,6 +232,19 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: ArrayLike, stand_ticks: A
         outcome=outcome, exit_code=EXIT_CODES[outcome], error=error, walk_stats=state.walk_stats,
         reached_stand=state.last_sent is not None and int(np.max(np.abs(state.last_sent - stand))) <= 1,
         torque_off=state.torque_off, notes=tuple(state.notes))
+
+
+def _first_frames(frames, joint_count: int) -> tuple[np.ndarray, Iterator | None]:
+    """(the frames as an array, None), or for an iterator (its first frame as a one-row array, the rest)."""
+    if isinstance(frames, Iterator):
+        first = next(frames, None)
+        if first is None:
+            raise ValueError("frames is empty: nothing to walk")
+        return as_tick_frames(np.asarray(first).reshape(1, -1), joint_count), frames
+    walk = as_tick_frames(frames, joint_count)
+    if walk.shape[0] == 0:
+        raise ValueError("frames is empty: nothing to walk")
+    return walk, None
 
 
 class _SessionState:
