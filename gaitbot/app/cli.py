@@ -38,7 +38,7 @@ from gaitbot.stream.signals import StopSignals, Terminated  # noqa: E402 - light
 #: Subcommand -> the module of gaitbot.app whose ``run(args)`` does it (imported when used: ``plot``
 #: needs matplotlib, ``walk --sim`` MuJoCo, and the rest should not wait for them).
 COMMANDS = {name: f"gaitbot.app.{name}" for name in ("plan", "generate", "plot", "walk", "check", "eigen", "record",
-                                                     "scan", "setup", "calibrate")}
+                                                     "scan", "setup", "calibrate", "drive")}
 
 #: What ``walk --dry-run`` and ``walk --sim`` walk when no steps are given: the demo (said on stderr).
 DEMO_DISTANCE_M = 0.5
@@ -153,6 +153,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "(N s, positive to the left) in the middle of a step half-way through the walk")
     p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (three-quarter view)")
     p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
+
+    parser.commands["drive"] = importlib.import_module("gaitbot.app.drive").add_parser(sub, COMMAND_HELP)
 
     p = parser.commands["check"] = _command(sub, "check")
     p.add_argument("file", help="trajectory (.csv, .npz) or bus recording (.jsonl)")
