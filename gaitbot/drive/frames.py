@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gaitbot.drive.guard import FrameGuard
+from gaitbot.drive.spread import SpreadReplan
 from gaitbot.gait.joints import LEG_JOINTS
 from gaitbot.gait.steer.command import STILL, TimedCommand, VelocityCommand
 from gaitbot.gait.steer.planner import frame_of, leading_side
@@ -68,6 +69,7 @@ class DriveLog:
     clipped: bool = False
     refused: str | None = None
     commands: list[TimedCommand] = field(default_factory=list)
+    latencies_s: list[float] = field(default_factory=list)  # from a new command to the start of its first step
 
 
 class DriveFrames:
@@ -94,6 +96,8 @@ class DriveFrames:
         self.stop_requested = False
         self.command = STILL
         self._received: VelocityCommand | None = None
+        self._changed_s: float | None = None
+        self._walker_k0 = 0
         self._walker = None
         self._planner = None
         self._origin = None
@@ -109,6 +113,8 @@ class DriveFrames:
     def _new_walker(self) -> None:
         """A walker standing where the drive stands (its own world; the odometry composes it)."""
         self._walker = balanced_walker(self.config, self.gait)
+        self._spread = SpreadReplan(self._walker)
+        self._next_step = None
         self._planner = footstep_planner(self.config, self.gait)
         self._origin = frame_of(self._walker.feet)
         self._started = False
@@ -127,7 +133,9 @@ class DriveFrames:
                 return self._hand_out(self.stand)
             walker.lead_with(leading_side(self.command))
             self._started = True
+            self._walker_k0 = self.k
         self._plan_ahead()
+        self._spread.work()
         frame = walker.next_frame()
         if frame is None:  # the walker has closed its feet and lowered to standing
             self._close_walker()
@@ -161,7 +169,10 @@ class DriveFrames:
         if end and not self.ending:
             self.ending = True
             self._record(TimedCommand(round(t_s, 6), stop=True))
-        self.command = STILL if self.ending else clipped
+        command = STILL if self.ending else clipped
+        if command != self.command:
+            self._changed_s = t_s
+        self.command = command
 
     def _record(self, timed: TimedCommand) -> None:
         self.log.commands.append(timed)
@@ -169,8 +180,14 @@ class DriveFrames:
             self.on_command(timed)
 
     def _plan_ahead(self) -> None:
-        """At most one step a frame, while fewer than queue_steps planned steps have not started."""
+        """At most one step a frame, while fewer than queue_steps planned steps have not started; a step is
+        planned and checked in one frame and handed to the walker in the next (spreading the work)."""
         walker, planner = self._walker, self._planner
+        if self._next_step is not None:
+            step, self._next_step = self._next_step, None
+            if not (walker.finished or self.ending):
+                self._append(step)
+            return
         if walker.finished or self.ending:
             return
         if self.command.is_still and planner.standing():
@@ -185,13 +202,23 @@ class DriveFrames:
         step = planner.next_step(self.command, side)
         gap = swept_gap_m(self.config.body.geometry, stance, old, step.foothold)
         if gap < self.config.steer.min_gap_m - GAP_TOLERANCE_M:
-            self._refuse(f"a step would bring the soles {gap * 1e3:.1f} mm apart; stopping instead")
-            self.ending = True
+            reason = f"a step would bring the soles {gap * 1e3:.1f} mm apart: replaced by a stop"
+            self.log.refused = self.log.refused or reason
+            self.say(reason)
+            self.ending = True  # no more steps: the walker closes the feet beside each other and stands
             return
+        self._next_step = step
+
+    def _append(self, step) -> None:
+        walker = self._walker
         walker.append_footstep(step.foothold, max(0.0, step.length_m))
+        if self._changed_s is not None:  # the first step planned since the command changed
+            start_s = self._walker_k0 * self.period_s + walker.planned_steps[-1].start_s
+            self.log.latencies_s.append(start_s - self._changed_s)
+            self._changed_s = None
         self.log.steps += 1
-        self.log.distance_m += math.hypot(step.forward_m, step.side_m if step.side_m * (1 if side == "left" else -1) > 0
-                                          else 0.0)
+        leading = step.side_m * (1 if step.foothold.side == "left" else -1) > 0
+        self.log.distance_m += math.hypot(step.forward_m, step.side_m if leading else 0.0)
 
     def _close_walker(self) -> None:
         """The walker stands: add its displacement to the odometry and get a fresh one for the next command."""
