@@ -197,17 +197,31 @@ class DriveFrames:
         if pending >= self.queue_steps:
             return
         side = walker.next_swing_side
-        stance = planner.feet["right" if side == "left" else "left"]
-        old = planner.feet[side]
-        step = planner.next_step(self.command, side)
-        gap = swept_gap_m(self.config.body.geometry, stance, old, step.foothold)
-        if gap < self.config.steer.min_gap_m - GAP_TOLERANCE_M:
-            reason = f"a step would bring the soles {gap * 1e3:.1f} mm apart: replaced by a stop"
-            self.log.refused = self.log.refused or reason
-            self.say(reason)
-            self.ending = True  # no more steps: the walker closes the feet beside each other and stands
+        step = self._checked_step(side, self.command)
+        if step is None:  # even slowing down would not keep the soles apart: no more steps
+            self.ending = True
             return
         self._next_step = step
+
+    def _checked_step(self, side: str, command: VelocityCommand):
+        """The planner's next step, its soles' swept gap checked again; a step that fails is replaced by a
+        slowing-down step (the still command, within the change limits) planned from the state before it,
+        and if that fails too, by None (a stop: the walker closes the feet)."""
+        planner = self._planner
+        before = planner.copy()
+        stance = planner.feet["right" if side == "left" else "left"]
+        old = planner.feet[side]
+        for attempt in (command, STILL):
+            step = planner.next_step(attempt, side)
+            gap = swept_gap_m(self.config.body.geometry, stance, old, step.foothold)
+            if gap >= self.config.steer.min_gap_m - GAP_TOLERANCE_M:
+                return step
+            reason = f"a step would bring the soles {gap * 1e3:.1f} mm apart: replaced by a stop"
+            if self.log.refused is None:
+                self.log.refused = reason
+                self.say(reason + " (said once)")
+            self._planner = planner = before.copy()
+        return None
 
     def _append(self, step) -> None:
         walker = self._walker
