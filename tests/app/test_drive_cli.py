@@ -152,3 +152,16 @@ def test_a_udp_sender_drives_and_its_silence_stands_the_robot(tmp_path):
     assert "no command for 0.5 s: standing" in err
     report = json.loads(out)
     assert report["pose"]["x_m"] > 0.02
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--input", "bogus"], "--input"),
+    (["--input", "commands:/nonexistent/c.jsonl"], "/nonexistent/c.jsonl"),
+    (["--max-time", "-1", "--input", "commands:config/commands/drive-demo.jsonl"], "--max-time"),
+    (["--robot", "xl430-biped", "--input", "commands:config/commands/drive-demo.jsonl"], "[steer]"),
+])
+def test_bad_input_is_one_line_and_exit_2(args, words):
+    result = gaitbot("drive", "--dry-run", *(["--robot", "op3"] if "--robot" not in args else []), *args)
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and words in lines[0] and "Traceback" not in result.stderr
