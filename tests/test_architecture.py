@@ -75,4 +75,4 @@ def test_the_top_of_the_package_holds_rooms():
     modules = sorted(p.name for p in top.glob("*.py"))
     assert modules == ["__init__.py", "__main__.py", "errors.py", "fields.py"]
     rooms = sorted(p.name for p in top.iterdir() if (p / "__init__.py").is_file())
-    assert rooms == ["app", "bus", "check", "gait", "plot", "robot", "servos", "sim", "stream"]
+    assert rooms == ["app", "bus", "check", "drive", "gait", "inputs", "plot", "robot", "servos", "sim", "stream"]
