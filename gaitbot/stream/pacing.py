@@ -218,13 +218,20 @@ class Streamer:
             last_write_s = previous_send_s
             min_interval_s = self.min_frame_interval_s
             while True:
-                work_cpu_start = cpu()
-                frame = next(rows, None)  # before the wait: a live frame's work does not delay its send
-                if frame is None:
-                    break
-                frame_cpu_s = cpu() - work_cpu_start
-                k, deadline_s, send_s = next(ticks)
-                work_cpu_start = cpu() - frame_cpu_s  # the wait is not work
+                if count is None:  # an iterator: its frame is made before the wait, so its work does not delay the send
+                    work_cpu_start = cpu()
+                    frame = next(rows, None)
+                    if frame is None:
+                        break
+                    frame_cpu_s = cpu() - work_cpu_start
+                    k, deadline_s, send_s = next(ticks)
+                    work_cpu_start = cpu() - frame_cpu_s  # the wait is not work
+                else:
+                    if stats.frames >= count:
+                        break
+                    k, deadline_s, send_s = next(ticks)
+                    work_cpu_start = cpu()
+                    frame = next(rows)
                 # Python ints (SDK packet builders want ints, not numpy scalars), one frame at a
                 # time: converting a whole one-hour walk up front would take ~100 MB.
                 goals = dict(zip(ids, frame.tolist()))
