@@ -164,6 +164,16 @@ def _sim_walk(args, config, frames: DriveFrames):
     return SimWalk(config, 1.0 / frames.period_s, plan, "free")
 
 
+def _ending(outcome: str, result) -> str:
+    """How the drive ended, in one sentence (a first signal is a drive that stood, not a session's abort)."""
+    if result.outcome == "completed" and outcome in ("interrupted", "terminated"):
+        how = "Ctrl-C" if outcome == "interrupted" else "SIGTERM"
+        return "; ".join([f"Drive stopped by {how}: steps finished, feet closed, standing", *result.notes]) + "."
+    if outcome == "refused":
+        return "Drive stopped: a frame was refused before it was sent; ramped to standing."
+    return result.message()
+
+
 def _report(args, config, frames: DriveFrames, result, first_signal, sim) -> int:
     exit_code = result.exit_code
     outcome = result.outcome
@@ -194,7 +204,7 @@ def _report(args, config, frames: DriveFrames, result, first_signal, sim) -> int
         p = report["pose"]
         print(f"{config.name}: drove {report['steps']} steps, {report['distance_m']:.3f} m; pose x {p['x_m']:.3f} m, "
               f"y {p['y_m']:.3f} m, heading {p['heading_deg']:.1f} deg{'; FELL' if report['fell'] else ''}. "
-              f"{result.message()}")
+              f"{_ending(outcome, result)}")
     return exit_code
 
 
