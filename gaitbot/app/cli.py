@@ -27,7 +27,7 @@ from gaitbot.stream.signals import StopSignals, Terminated  # light: rooms come 
 #: (``run(args)``). Only the module of the command given is imported (``plot`` needs matplotlib, ``walk
 #: --sim`` MuJoCo, and the rest should not wait for them); the others appear in ``--help`` by their summary.
 COMMANDS = {name: f"gaitbot.app.{name}" for name in ("plan", "generate", "plot", "walk", "check", "eigen", "record",
-                                                     "scan", "setup", "calibrate", "robot")}
+                                                     "scan", "setup", "calibrate", "robot", "drive")}
 
 #: Exit status when the reader of our output went away (like a program killed by SIGPIPE: 128 + 13).
 EXIT_BROKEN_PIPE = 141

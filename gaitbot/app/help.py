@@ -83,6 +83,13 @@ COMMAND_HELP = {
         ("gaitbot walk --dry-run",
          "gaitbot walk --distance 1.0 --dry-run --record run.jsonl",
          "gaitbot walk --sim --distance 0.5")),
+    "drive": CommandHelp(
+        "drive the robot live from a keyboard, a gamepad, UDP or a commands file",
+        "Plan each step from the latest velocity command while the robot walks, check every frame before it\n"
+        "is sent, and stream it at the robot's frame rate (docs/driving.md). Ctrl-C stops stepping and\n"
+        "stands; a second Ctrl-C hurries to the stop ramp.",
+        ("gaitbot drive --robot op3 --dry-run --input commands:config/commands/drive-demo.jsonl",),
+        ("gaitbot drive --robot op3 --input keyboard",)),
     "check": CommandHelp(
         "check a trajectory or a recorded run against the robot's limits",
         "Say joint by joint whether, and where, a trajectory or a bus recording breaks a position, tick,\n"

@@ -211,7 +211,7 @@ class Streamer:
         count = len(frames) if hasattr(frames, "__len__") else 0
         source = tick_frames(frames, len(self.ids))
         stats = StreamStats(period_s=self.period_s, late_threshold_s=self.late_threshold_s,
-                            lateness_s=np.zeros(count), bus_call_s=np.zeros(count))
+                            lateness_s=np.zeros(count or 1024), bus_call_s=np.zeros(count or 1024))
         self.stats = stats
         clock, bus, ids, cpu, monitor = self.clock, self.bus, self.ids, self.cpu_time_s, self.monitor
         cpu_start = cpu()

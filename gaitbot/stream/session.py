@@ -441,6 +441,19 @@ def walk_session(bus: Bus, ids: Sequence[int], frames: FrameSource, stand_ticks:
     return session.run(frames, on_frame)
 
 
+def _first_frames(frames, joint_count: int) -> tuple[np.ndarray, Iterator | None]:
+    """(the frames as an array, None), or for an iterator (its first frame as a one-row array, the rest)."""
+    if isinstance(frames, Iterator):
+        first = next(frames, None)
+        if first is None:
+            raise ValueError("frames is empty: nothing to walk")
+        return as_tick_frames(np.asarray(first).reshape(1, -1), joint_count), frames
+    walk = as_tick_frames(frames, joint_count)
+    if walk.shape[0] == 0:
+        raise ValueError("frames is empty: nothing to walk")
+    return walk, None
+
+
 class _SessionState:
     """What the session has done so far, so that each way out knows what to undo."""
 

@@ -1,0 +1,212 @@
+"""``gaitbot drive`` (its run; the options are in gaitbot.app.drive): the live walk, steered from a keyboard, a gamepad, UDP datagrams or a commands file.
+
+The frame source (gaitbot.drive.frames) plans each step from the latest command and checks every frame
+before it goes out; the walk session streams it exactly as ``gaitbot walk`` streams a planned walk (the
+LimitGuard, --record, the health read-back, the stop ramp on a bus fault). The first Ctrl-C or SIGTERM
+stops stepping, closes the feet and stands (exit 130 or 143); a second one hurries to the session's stop
+ramp. docs/driving.md.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import signal
+import sys
+import threading
+
+from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
+from gaitbot.app.options import UsageError, load_robot
+from gaitbot.app.outputs import output_path
+from gaitbot.bus.factory import guarded, make_robot_bus
+from gaitbot.bus.recording import BusRecorder
+from gaitbot.drive.frames import DriveFrames, command_limits
+from gaitbot.errors import UserError
+from gaitbot.inputs.open import open_source
+from gaitbot.robot.calibration import standing_ticks
+from gaitbot.robot.gains import gain_writes
+from gaitbot.robot.steered_walk import footstep_planner
+from gaitbot.robot.walk_settings import joint_limits_ticks
+from gaitbot.stream.clock import MonotonicClock, VirtualClock
+from gaitbot.stream.health import HealthMonitor
+from gaitbot.stream.session import walk_session
+from gaitbot.stream.signals import Terminated
+
+MAX_TIME_S = 24 * 3600.0
+
+
+def _check_args(args) -> None:
+    if args.sim and (args.dry_run or args.port or args.realtime):
+        raise UsageError("--sim: give --sim alone (not with --dry-run, --port or --realtime)")
+    if args.max_time is not None and not (math.isfinite(args.max_time) and 0 < args.max_time <= MAX_TIME_S):
+        raise UsageError(f"--max-time must be more than 0 and at most {MAX_TIME_S:g} seconds, got {args.max_time!r}")
+    for flag in ("record", "record_commands"):
+        if getattr(args, flag):
+            output_path(getattr(args, flag), f"--{flag.replace('_', '-')}", args)
+
+
+class GracefulSignals:
+    """First SIGINT/SIGTERM: ask the drive to stop stepping and stand; the second raises as the session expects."""
+
+    def __init__(self, frames: DriveFrames) -> None:
+        self.frames = frames
+        self.first: int | None = None
+        self._old: dict = {}
+
+    def handler(self, signum, _frame) -> None:
+        if self.first is None:
+            self.first = signum
+            self.frames.stop_requested = True
+            return
+        raise Terminated(f"received signal {signum}") if signum == signal.SIGTERM else KeyboardInterrupt
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self._old = {s: signal.signal(s, self.handler) for s in (signal.SIGINT, signal.SIGTERM)}
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for signum, old in self._old.items():
+            signal.signal(signum, old)
+
+
+def _say(text: str) -> None:
+    print(("\n" if sys.stderr.isatty() else "") + f"drive: {text}", file=sys.stderr, flush=True)
+
+
+def _status_line(frames: DriveFrames, health: HealthMonitor):
+    """On a terminal: command, planned speed, steps and servo health, twice a second; nothing in a pipe."""
+    if not sys.stderr.isatty():
+        return None
+    last = {"k": 0, "pose": (0.0, 0.0, 0.0)}
+
+    def on_frame(k: int, stats) -> None:
+        if k % 30:
+            return
+        x, y, _ = frames.walk_pose()
+        px, py, _ = last["pose"]
+        speed = math.hypot(x - px, y - py) / max(1e-9, (k - last["k"]) * frames.period_s) if k else 0.0
+        last.update(k=k, pose=(x, y, 0.0))
+        c = frames.command
+        servo = health.status or "servos ok"
+        print(f"\rcommand ({c.vx_m_s:+.3f} m/s, {c.vy_m_s:+.3f} m/s, {c.wz_deg_s:+.1f} deg/s)  speed {speed:.3f} m/s  "
+              f"steps {frames.log.steps}  {servo}  ", end="", file=sys.stderr, flush=True)
+
+    return on_frame
+
+
+def run(args) -> int:
+    _check_args(args)
+    refuse_port_in_dry_run(args)
+    config = load_robot(args.robot, getattr(args, "calibration", None))
+    if config.steer is None:
+        raise UsageError(f"--robot {args.robot or config.name}: {config.name} has no [steer] table: it cannot be driven")
+    step_s = footstep_planner(config).step_s
+    top, bottom = command_limits(config.steer, step_s)
+    commands_out = open(args.record_commands, "w", encoding="utf-8") if args.record_commands else None  # noqa: SIM115
+    source = open_source(args.input, top, bottom)
+    try:
+        return _drive(args, config, source, commands_out)
+    finally:
+        source.close()
+        if commands_out is not None:
+            commands_out.close()
+
+
+def _drive(args, config, source, commands_out) -> int:
+    def on_command(timed) -> None:
+        if commands_out is not None:
+            commands_out.write(timed.to_json() + "\n")
+            commands_out.flush()
+
+    frames = DriveFrames(config, source, max_time_s=args.max_time, say=_say, on_command=on_command)
+    sim = None
+    if args.sim:
+        sim = _sim_walk(args, config, frames)
+    hardware = not (args.dry_run or args.sim)
+    port = serial_port(config, args.port, dry_run=not hardware)
+    clock = MonotonicClock() if (hardware or args.realtime or args.input != "commands" and
+                                 not args.input.startswith("commands:")) else VirtualClock()
+    if hardware:
+        warn_about_latency(port)
+    recorder = None
+    if args.record:
+        recorder = BusRecorder(args.record, robot=config.name, joints={j.name: j.id for j in config.joints},
+                               clock=clock.now, rate_hz=1.0 / frames.period_s)
+    try:
+        bus = (guarded(config, sim.make_bus(clock.now, recorder)) if sim is not None else
+               make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,
+                              reply_timeout_ms=args.reply_timeout_ms, clock=clock.now))
+    except OSError as exc:
+        raise UsageError(f"--record {args.record}: cannot write the recording ({exc.strerror or exc})") from None
+    velocity, acceleration = joint_limits_ticks(config)
+    health = HealthMonitor.for_robot(config, _say, clock.now)
+    try:
+        with GracefulSignals(frames) as signals:
+            result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
+                                  max_accel_ticks_per_s2=acceleration, period_s=frames.period_s, clock=clock,
+                                  torque_off_on_exit=config.bus.torque_off_on_exit,
+                                  on_frame=_status_line(frames, health), handle_sigterm=False,
+                                  setup_writes=gain_writes(config), health=health)
+    finally:
+        if recorder is not None:
+            recorder.close()
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    return _report(args, config, frames, result, signals.first, sim)
+
+
+def _sim_walk(args, config, frames: DriveFrames):
+    from gaitbot.sim.metrics import WalkPlan
+    from gaitbot.sim.walk import SimWalk
+
+    start = {name: 0.0 for name in config.walking_joint_names}
+    plan = WalkPlan(distance_m=0.0, start_angles_rad=start, start_root_m=frames.start_root_m)
+    return SimWalk(config, 1.0 / frames.period_s, plan, "free")
+
+
+def _ending(outcome: str, result) -> str:
+    """How the drive ended, in one sentence (a first signal is a drive that stood, not a session's abort)."""
+    if result.outcome == "completed" and outcome in ("interrupted", "terminated"):
+        how = "Ctrl-C" if outcome == "interrupted" else "SIGTERM"
+        return "; ".join([f"Drive stopped by {how}: steps finished, feet closed, standing", *result.notes]) + "."
+    if outcome == "refused":
+        return "Drive stopped: a frame was refused before it was sent; ramped to standing."
+    return result.message()
+
+
+def _report(args, config, frames: DriveFrames, result, first_signal, sim) -> int:
+    exit_code = result.exit_code
+    outcome = result.outcome
+    if outcome == "completed" and first_signal is not None:
+        outcome, exit_code = ("terminated", 143) if first_signal == signal.SIGTERM else ("interrupted", 130)
+    if outcome == "completed" and frames.log.refused:
+        outcome, exit_code = "refused", 1
+    x, y, heading = frames.walk_pose()
+    report = {"robot": config.name, "input": args.input, "outcome": outcome,
+              "pose": {"x_m": x, "y_m": y, "heading_deg": math.degrees(heading)},
+              "distance_m": frames.log.distance_m, "steps": frames.log.steps, "clipped": frames.log.clipped,
+              "refused": frames.log.refused, "fell": False, "frames": frames.k,
+              "notes": list(result.notes), "error": str(result.error) if result.error else None}
+    if sim is not None:
+        measured = sim.report()
+        report["planned_pose"] = report["pose"]
+        report["pose"] = {"x_m": measured.distance_travelled_m, "y_m": measured.lateral_drift_m,
+                          "heading_deg": measured.heading_deg}
+        report["fell"] = measured.fell
+        report["fall_reason"] = measured.fall_reason
+        report["worst_tilt_deg"] = max(measured.torso_roll_max_deg, measured.torso_pitch_max_deg)
+        if measured.fell and exit_code == 0:
+            exit_code = 1
+    report["exit_status"] = exit_code
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        p = report["pose"]
+        print(f"{config.name}: drove {report['steps']} steps, {report['distance_m']:.3f} m; pose x {p['x_m']:.3f} m, "
+              f"y {p['y_m']:.3f} m, heading {p['heading_deg']:.1f} deg{'; FELL' if report['fell'] else ''}. "
+              f"{_ending(outcome, result)}")
+    return exit_code
+
+
+__all__ = ["run", "UserError"]

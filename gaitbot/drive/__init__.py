@@ -1,0 +1,2 @@
+"""The live drive (``gaitbot drive``): a frame source that plans each step from the latest command while the
+robot walks, checks every frame before it is sent, and ends standing (docs/driving.md)."""
