@@ -27,7 +27,7 @@ def _normal(name: str) -> str:
 def _requirements():
     project = PYPROJECT["project"]
     extras = project["optional-dependencies"]
-    for text in [*project["dependencies"], *extras["test"], *extras["plot"], *extras["sim"]]:
+    for text in [*project["dependencies"], *(r for extra in ("test", "plot", "sim", "view", "ecosystem", "drive") for r in extras[extra])]:
         requirement = Requirement(text)
         if requirement.name != "gaitbot" and (requirement.marker is None or requirement.marker.evaluate()):
             yield requirement

@@ -15,7 +15,7 @@ import re
 import sys
 from importlib import metadata
 
-EXTRAS = ("test", "plot", "sim")
+EXTRAS = ("test", "plot", "sim", "view", "ecosystem", "drive")
 _NAME = re.compile(r"^\s*([A-Za-z0-9][A-Za-z0-9._-]*)(?:\[([^\]]*)\])?")
 
 
