@@ -34,10 +34,26 @@ def test_missing_extra_is_one_line(missing, flag, monkeypatch, tmp_path):
         open_view(args, config("op3"), None)
 
 
-def test_a_full_disk_stops_the_log_not_the_walk(capsys):
-    code, out, err = run_cli(capsys, "walk", "--robot", "op3", "--dry-run", "--distance", "0.3", "--mcap", "/dev/full")
+def test_a_full_disk_stops_the_log_not_the_walk(capsys, monkeypatch, tmp_path):
+    """The disk fills up after the log has started (outputs must be regular files, so /dev/full is refused up
+    front): every write from the 50th on fails as a full disk does, with ENOSPC."""
+    import errno
+
+    from gaitbot.view.mcap_log import McapSink
+
+    write, calls = McapSink.write, {"n": 0}
+
+    def filling(self, *args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] >= 50:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return write(self, *args, **kwargs)
+
+    monkeypatch.setattr(McapSink, "write", filling)
+    log = tmp_path / "w.mcap"
+    code, out, err = run_cli(capsys, "walk", "--robot", "op3", "--dry-run", "--distance", "0.3", "--mcap", str(log))
     assert code == 0 and "Walk completed" in out
-    assert "note: --mcap /dev/full stopped at" in err and "No space left on device" in err
+    assert f"note: --mcap {log} stopped at" in err and "No space left on device" in err
 
 
 @pytest.mark.parametrize("argv, says", [
