@@ -81,7 +81,7 @@ def menagerie_sole_gap_m(trajectory) -> float:
 
     model = mujoco.MjModel.from_xml_string(op3_menagerie.menagerie_mjcf())
     data = mujoco.MjData(model)
-    names = [f"{k}_{s}" for s in ("left", "right") for k in op3_menagerie.JOINT_MAP]
+    names = list(op3_menagerie.SIM_MAP.joints)  # every leg joint the map drives
     theirs = [op3_menagerie.their_joint(n) for n in names]
     qadr = np.array([model.joint(t).qposadr[0] for t, _ in theirs])
     signs = np.array([s for _, s in theirs], dtype=float)

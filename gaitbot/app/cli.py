@@ -21,7 +21,7 @@ from gaitbot import __version__
 from gaitbot.app.arguments import add_command
 from gaitbot.app.help import DESCRIPTION, EPILOG, HelpFormatter
 from gaitbot.errors import UserError
-from gaitbot.stream.signals import StopSignals, Terminated  # light: rooms come with the commands
+from gaitbot.stream.signals import StopSignals, Terminated, signals_held  # light: rooms come with the commands
 
 #: Subcommand -> the module of gaitbot.app that adds its sub-parser (``add_parser(subparsers)``) and does it
 #: (``run(args)``). Only the module of the command given is imported (``plot`` needs matplotlib, ``walk
@@ -115,7 +115,8 @@ def _signal_status(signum: int | None) -> int:
 def _main(argv: Sequence[str] | None, signals: StopSignals) -> int:
     argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
     name = command_named(argv)
-    parser = build_parser([name] if name else [])
+    with signals_held():  # the command's module (numpy, the SDKs) is imported here
+        parser = build_parser([name] if name else [])
     args = parser.parse_args(argv)
     module = importlib.import_module(COMMANDS[args.command])
     check = getattr(module, "check_arguments", None)

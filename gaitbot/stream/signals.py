@@ -150,3 +150,20 @@ def restore_sigterm_handler(old_handler: object) -> None:
         return
     # None means the previous handler was not set from Python; the default is the best we can do.
     signal.signal(signal.SIGTERM, signal.SIG_DFL if old_handler is None else old_handler)
+
+
+@contextmanager
+def signals_held():
+    """SIGINT and SIGTERM held back by the OS (main thread, where the platform can) while a block runs, then let
+    through: a signal that interrupted an extension module's import half-way (numpy's imports run Python from C)
+    can turn into an ImportError with a traceback; held, it is handled just after, where the caller expects it."""
+    mask = getattr(signal, "pthread_sigmask", None)
+    if mask is None or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held = {signal.SIGINT, signal.SIGTERM}
+    mask(signal.SIG_BLOCK, held)
+    try:
+        yield
+    finally:
+        mask(signal.SIG_UNBLOCK, held)

@@ -43,7 +43,9 @@ def files(tmp_path_factory):
     assert main(["robot", "export", "op3", "--urdf", str(folder / "op3.urdf")]) == 0
     tight = folder / "tight.toml"
     tight.write_text((CONFIG_DIR / "xl430-biped.toml").read_text().replace("max_deg = 110.0", "max_deg = 20.0"))
-    return {"walk": walk, "broken": broken, "examples": examples, "model": model, "tight": tight, "out": folder}
+    commands = CONFIG_DIR / "commands" / "drive-demo.jsonl"
+    return {"walk": walk, "broken": broken, "examples": examples, "model": model, "tight": tight, "out": folder,
+            "commands": commands}
 
 
 def _argv(template: str, files) -> list[str]:
@@ -84,6 +86,8 @@ CASES = [
     ("robot export", "robot export op3", 2),  # no output named
     ("robot import", "robot import {out}/op3.urdf --like op3 -o {out}/mine.toml", 0),
     ("robot import", "robot import {walk} -o {out}/mine.toml", 2),  # a CSV is not a robot description
+    ("drive", "drive --robot op3 --dry-run --input commands:{commands}", 0),
+    ("drive", "drive --robot xl430-biped --dry-run --input commands:{commands}", 2),  # no [steer]
 ]
 
 
