@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from gaitbot.gait.trajectory import Trajectory
-from tests.helpers import run_cli
+from helpers import run_cli
 
 
 def test_plan_json_gives_each_footstep_and_the_end_poses(capsys):

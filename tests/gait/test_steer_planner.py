@@ -21,7 +21,7 @@ from gaitbot.gait.steer.planner import leading_side
 from gaitbot.gait.steer.schedule import CommandSchedule, plan_footsteps
 from gaitbot.robot.steered_walk import footstep_planner, plan_steered, steering_timing
 from gaitbot.robot.balanced_walk import balanced_gait_settings
-from tests.helpers import config
+from helpers import config
 
 OP3 = config("op3")
 WALKS = {"turn": VelocityCommand(0.0, 0.0, 12.0), "side_left": VelocityCommand(0.0, 0.03, 0.0),

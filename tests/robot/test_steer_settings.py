@@ -3,7 +3,7 @@
 import pytest
 
 from gaitbot.gait.steer.limits import SteerLimits
-from tests.robot.test_robot_config_3d import OP3_TEXT, expect
+from test_robot_config_3d import OP3_TEXT, expect  # tests/robot is on the path (pytest prepend import mode)
 
 
 def with_steer_line(key: str, value: str | None) -> str:
@@ -20,7 +20,7 @@ def with_steer_line(key: str, value: str | None) -> str:
 
 
 def test_the_op3_and_bioloid_have_steering_limits():
-    from tests.helpers import config
+    from helpers import config
 
     for robot in ("op3", "bioloid"):
         steer = config(robot).steer

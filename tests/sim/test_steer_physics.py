@@ -12,7 +12,7 @@ import sys
 
 import pytest
 
-from tests.helpers import REPO_ROOT
+from helpers import REPO_ROOT
 
 sys.path.insert(0, str(REPO_ROOT / "tools"))
 import steer_judge  # noqa: E402
