@@ -46,9 +46,21 @@ class Watchdog:
     def __init__(self, limit_s: float = WATCHDOG_S) -> None:
         self.limit_s = limit_s
         self.last_fed_s: float | None = None
+        self._said = False
 
     def feed(self, now_s: float) -> None:
         self.last_fed_s = now_s
+        self._said = False
 
     def expired(self, now_s: float) -> bool:
         return self.last_fed_s is not None and now_s - self.last_fed_s > self.limit_s
+
+    def stand_if_silent(self, command: VelocityCommand, now_s: float, reading: Reading, silence: str) -> VelocityCommand:
+        """The command in force: STILL once a moving command has gone unfed past the limit, said once a silence
+        (``silence``: what fell silent, e.g. "udp: no command")."""
+        if command.is_still or not self.expired(now_s):
+            return command
+        if not self._said:
+            reading.messages.append(f"{silence} for {self.limit_s:g} s: standing")
+            self._said = True
+        return STILL

@@ -57,7 +57,6 @@ class UdpSource:
         self.command = STILL
         self.watchdog = Watchdog()
         self.ignored = 0
-        self._silent_said = False
 
     @classmethod
     def bind(cls, rest: str) -> "UdpSource":
@@ -90,17 +89,12 @@ class UdpSource:
                     reading.messages.append(f"udp: ignored a datagram from {sender[0]}: {exc} (said once)")
                 continue
             self.watchdog.feed(now_s)
-            self._silent_said = False
             if end:
                 reading.end = True
                 self.command = STILL
             else:
                 self.command = command
-        if not self.command.is_still and self.watchdog.expired(now_s):
-            self.command = STILL
-            if not self._silent_said:
-                reading.messages.append(f"udp: no command for {self.watchdog.limit_s:g} s: standing")
-                self._silent_said = True
+        self.command = self.watchdog.stand_if_silent(self.command, now_s, reading, "udp: no command")
         reading.command = self.command
         return reading
 

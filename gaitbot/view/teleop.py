@@ -91,7 +91,6 @@ class TeleopSource:
         self.command = STILL
         self.watchdog = Watchdog()
         self.ignored = 0
-        self._silent_said = False
         self._on_close = on_close
 
     def poll(self, now_s: float) -> Reading:
@@ -108,12 +107,7 @@ class TeleopSource:
                 continue
             self.command = command
             self.watchdog.feed(now_s)
-            self._silent_said = False
-        if not self.command.is_still and self.watchdog.expired(now_s):
-            self.command = STILL
-            if not self._silent_said:
-                reading.messages.append(f"foxglove: no Twist for {self.watchdog.limit_s:g} s: standing")
-                self._silent_said = True
+        self.command = self.watchdog.stand_if_silent(self.command, now_s, reading, "foxglove: no Twist")
         reading.command = self.command
         return reading
 
