@@ -99,7 +99,6 @@ def run(args) -> int:
     check_reply_timeout(args.reply_timeout_ms)
     config = load_robot(args.robot, getattr(args, "calibration", None))
     check_rate_option(config, args.rate)
-    feedback_wanted = feedback_mode(args, config)  # refused here (one line) when the robot has no IMU
     walk = planned_walk(args, config)
     report = preflight(config, walk.goals, on_boom=args.boom, planned=walk.planned)
     if not report.ok:
@@ -131,7 +130,7 @@ def run(args) -> int:
         print(f"note: {note}", file=sys.stderr)
     health = HealthMonitor.for_robot(config, _warn_line, clock.now)
     velocity, acceleration = joint_limits_ticks(config)
-    feedback = make_feedback(config, feedback_wanted, bus, clock, 1.0 / walk.rate_hz)
+    feedback = make_feedback(config, feedback_mode(args, config), bus, clock, 1.0 / walk.rate_hz)
     session = WalkSession(bus, config.ids, standing_ticks(config),
                           SessionLimits(velocity, acceleration, 1.0 / walk.rate_hz), clock=clock,
                           torque_off_on_exit=config.bus.torque_off_on_exit, setup_writes=gain_writes(config),
