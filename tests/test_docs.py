@@ -1,6 +1,7 @@
 """The docs hold together: the README's first screen links every page, every relative link and every
-``gaitbot/...`` or ``tools/...`` path the docs name exists, and every code comment that names the walking
-model's page names docs/gait-model.md."""
+``gaitbot/...`` or ``tools/...`` path the docs name exists, every code comment that names the walking
+model's page names docs/gait-model.md, the command line's table lists every command, and the docs' index
+sorts every page into one kind."""
 
 from __future__ import annotations
 
@@ -37,3 +38,34 @@ def test_comments_name_the_model_page_by_its_path():
             if "gait-model.md" in line and source.name != "test_docs.py":
                 assert "docs/gait-model.md" in line, (source, line)
     assert (REPO_ROOT / "docs" / "gait-model.md").is_file()
+
+
+def _table_commands(page_text: str) -> set[str]:
+    """The commands named in the first column of docs/command-line.md's command table."""
+    table = page_text.split("| command | what it does | needs |", 1)[1].split("\n\n", 1)[0]
+    names = set()
+    for row in table.splitlines()[2:]:
+        first_cell = row.split("|")[1]
+        names.update(re.findall(r"`gaitbot ([a-z]+(?: [a-z]+)?)`", first_cell))
+    return names
+
+
+def test_the_command_table_lists_every_command():
+    """docs/command-line.md's table is every command: each command and subcommand the parser has (the
+    leaves: ``eigen fit``, not ``eigen``), and nothing the parser does not have."""
+    from gaitbot.app.cli import build_parser
+
+    commands = set(build_parser().commands)
+    leaves = {name for name in commands if not any(other.startswith(name + " ") for other in commands)}
+    listed = _table_commands((REPO_ROOT / "docs" / "command-line.md").read_text())
+    assert listed == leaves, (sorted(leaves - listed), sorted(listed - leaves))
+
+
+def test_the_index_sorts_every_page_by_kind():
+    """docs/README.md links every other page once, under one of the four kinds (tutorial, how-to,
+    reference, explanation)."""
+    index = (REPO_ROOT / "docs" / "README.md").read_text()
+    sections = re.split(r"^## ", index, flags=re.M)[1:]
+    assert len(sections) == 4, [s.splitlines()[0] for s in sections]
+    linked = [target for section in sections for target in re.findall(r"\]\(([\w-]+\.md)\)", section)]
+    assert sorted(linked) == sorted(p.name for p in DOCS if p.name != "README.md")
