@@ -6,7 +6,7 @@
 
 Writes a valid walk-shaped CSV of the given size (the generate format: t_s, six joint angles, the root) in a
 temporary folder, then runs ``gaitbot check`` on it in this process and prints the seconds, the rate in MB/s
-and what that rate makes of the largest allowed file (issue 26 item 9: it must be checked within a minute).
+and what that rate makes of the largest allowed file (it must be checked within a minute).
 """
 
 from __future__ import annotations

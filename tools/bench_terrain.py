@@ -1,4 +1,4 @@
-"""Benchmark of the terrain walker (seed 003): a 10-stair course, and the grid search on the examples.
+"""Benchmark of the terrain walker (Zhang 2008): a 10-stair course, and the grid search on the examples.
 
     python tools/bench_terrain.py                    # both parts
     python tools/bench_terrain.py stairs [--rise 0.035 --going 0.16 --repeat 3]
@@ -10,7 +10,7 @@ every frame) and frames per second, and the grid search's cells scored against t
 full search per MDS point, for ten stairs up (default robot; rise and going as given).
 
 search: for every MDS point of every example course (config/terrain/ for the default robot,
-config/terrain/<robot>/ for the others): the cost of seed 003's two-level search, of simply taking
+config/terrain/<robot>/ for the others): the cost of Zhang's two-level search, of simply taking
 the middle of the region, and of a 25 x 25 brute force of the same region, with the cells each
 scored. Per course the sums and the worst ratio of two-level to brute force are printed.
 """

@@ -1,4 +1,4 @@
-"""Timing of the fault policy (docs/bus-faults.md): each fault of issue 13 on the servo emulator, in real time.
+"""Timing of the fault policy (docs/bus-faults.md): each fault of the fault policy on the servo emulator, in real time.
 
     python tools/fault_timing.py                 # every robot, every fault, the fault at goal frame 120
     python tools/fault_timing.py --robot xl430-biped --repeat 3

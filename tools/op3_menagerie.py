@@ -94,7 +94,7 @@ MAP_PATH = Path(__file__).resolve().parents[1] / "config" / "sim-maps" / "op3-me
 SIM_MAP = load_sim_map(MAP_PATH)
 ARM_HOLD_RAD = hold_rad(SIM_MAP)
 FALL_TILT_DEG = 45.0
-PLAN_SHARE = 0.15  # --play's pass: within 15% of the planned distance (issue 24)
+PLAN_SHARE = 0.15  # --play's pass: within 15% of the planned distance
 PUSH_DURATION_S = 0.1
 SETTLE_AFTER_S = 1.0
 

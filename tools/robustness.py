@@ -15,7 +15,7 @@ Every walk is planned once, from the shipped config/op3.toml, exactly as ``gaitb
 - MuJoCo Menagerie's OP3 (tools/op3_menagerie.py: other authors' masses, axes and soft servos) with the
   plain planned angles: what a user playing ``gaitbot generate`` output on another model sends it;
 - a 0.7 N s sideways push in the middle of a step half-way through the walk (both ways).
-Pass: issue 15's targets (no fall, travelled within 10% of the plan, lateral drift under 5 cm, yaw
+Pass: the balanced walk's targets (no fall, travelled within 10% of the plan, lateral drift under 5 cm, yaw
 under 5 deg, torso roll and pitch RMS under 2 deg); for pushes, no fall. Goals here are floats (the
 CLI's walk --sim sends them as servo ticks through the bus: figures differ in the last digit).
 Exit status 1 if any row fails.

@@ -5,7 +5,7 @@ boom, and what the two walking settings of their configs are worth (the sim extr
     python tools/sim_figures.py --markdown    # the figures of docs/simulation.md (tools/figures.py)
 
 Every figure is a ``gaitbot walk --sim --json`` run through the command line itself: the op3 walks of
-OP3_WALKS and the bioloid's of BIOLOID_WALKS (issue 15's targets); per pitch-only robot, 1 m with the
+OP3_WALKS and the bioloid's of BIOLOID_WALKS (the balanced walk's targets); per pitch-only robot, 1 m with the
 pitch held and with it free; the same walks with the ankle at the heel (``heel_back_m = 0``), at the servos'
 factory gains (no ``[servo] full_torque_error_deg``), and both; and toe drag (``--clearance 0``) at factory
 and at the shipped gains. The simulation is deterministic on one machine; another CPU or MuJoCo release moves the figures within

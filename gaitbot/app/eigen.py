@@ -12,7 +12,7 @@ about example files that break the robot's limits.
 synth: a walk at ``--step-length`` (optionally going to ``--to-step-length``), written in the
 trajectory format with the model's joints and the root from foot contact; optionally forced through
 ``--pose-deg`` (one angle per joint of the model, in its order) at ``--pose-time`` seconds into each
-synthesised cycle (seed 004 eq. 13). The walk starts standing and ends standing: the robot's own
+synthesised cycle (Li et al. 2009 eq. 13). The walk starts standing and ends standing: the robot's own
 walker's first steps, the synthesised cycles, its closing step (see gait/eigen/synth.py).
 The walk is checked as ``gaitbot walk`` would check it, limits and (for a robot not on a boom)
 balance: one that fails (a forced pose far from the examples' at that time can distort the whole

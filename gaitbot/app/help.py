@@ -99,7 +99,7 @@ COMMAND_HELP = {
          "gaitbot check walk.csv",
          "gaitbot check --json walk.csv")),
     "eigen": CommandHelp(
-        "eigen-gaits (seed 004): learn walks from examples, synthesise new ones",
+        "eigen-gaits (Li et al. 2009): learn walks from examples, synthesise new ones",
         "Learn the main ways example walks differ (eigen-motions, by functional PCA) and synthesise new\n"
         "walks from them: at a step length between the examples', changing step length, or forced\n"
         "through a pose (docs/eigen-gaits.md).",

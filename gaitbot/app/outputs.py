@@ -1,4 +1,4 @@
-"""Output files: the one check every command runs on a path it will write, and the atomic write (issue 26).
+"""Output files: the one check every command runs on a path it will write, and the atomic write.
 
 A command's output must never destroy what the user had: ``walk --trajectory w.csv --record w.csv`` would
 overwrite the walk it is playing, ``eigen fit ex.npz -o ex.npz`` an example, ``calibrate -o

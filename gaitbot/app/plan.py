@@ -65,7 +65,7 @@ def _plan_terrain(args, walk) -> int:
         print(f"{label:>4} {s['leg']:>5} {s['length_m']:9.4f} {s['start_s']:8.3f} {s['end_s']:7.3f} "
               f"{s['foothold_m']:10.4f} {s['height_m']:8.4f} {s['method']:>8} {s['lift_m']:7.4f}")
     if plan["searches"]:
-        print("Pelvis low points between steps (mid double support, MDS), each chosen by seed 003's grid search "
+        print("Pelvis low points between steps (mid double support, MDS), each chosen by Zhang's grid search "
               "for the least joint acceleration (cost: weighted squared joint accelerations, (rad/s^2)^2 s):")
     for i, r in enumerate(plan["searches"], start=1):
         centre = f"{r['centre_cost']:.4g}" if r["centre_cost"] is not None else "out of the legs' reach"

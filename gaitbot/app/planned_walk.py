@@ -127,7 +127,7 @@ def plan_balanced_walk(request: WalkRequest) -> PlannedWalk:
 
 
 def plan_terrain(request: WalkRequest) -> PlannedWalk:
-    """``--terrain FILE``: footholds, pelvis search and trajectory (seed 003 joined to the flat walker)."""
+    """``--terrain FILE``: footholds, pelvis search and trajectory (Zhang 2008 joined to the flat walker)."""
     source, args = request.source, request.options
     if source.balanced:
         raise UsageError(f"--terrain: robot {source.robot.name} walks with the balanced walker, which walks "

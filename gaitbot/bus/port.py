@@ -51,7 +51,7 @@ class port_errors:  # noqa: N801 (used as a function: with port_errors(...))
     """One exchange with the SDK on ``port``: an OS-level failure of the port becomes PortError (never
     retried), and the SDK's lock is released however the block ends -- a KeyboardInterrupt or SIGTERM
     landing between the SDK taking its lock and giving it back must not leave every later packet, a stop
-    ramp's included, refused as "Port is in use!" (issue 26). ``pass_through``: exceptions of the layers
+    ramp's included, refused as "Port is in use!". ``pass_through``: exceptions of the layers
     under the port that are not the port's failure (a recording that could not be written). A class, not a
     generator: it wraps every exchange of the 60 Hz path."""
 

@@ -16,7 +16,7 @@ from gaitbot.gait.steer.soles import polygon_gap
 from gaitbot.robot.config import RobotConfig
 
 DEFAULT_MARGIN_M = 0.005
-"""The least gap a robot without a [steer] table must keep (the steering issue's bar)."""
+"""The least gap a robot without a [steer] table must keep (the bar the steering walks are judged by)."""
 PLAN_TOLERANCE_M = 0.001
 """The planner keeps min_gap_m on its sampled swing path; between samples and through the legs' IK the
 gap may come this much closer."""

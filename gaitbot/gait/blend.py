@@ -1,4 +1,4 @@
-"""Bernstein (Bezier) weighting of Boulic poses between steps of different length (seed 000 eq. 14).
+"""Bernstein (Bezier) weighting of Boulic poses between steps of different length (Jing et al. 2015 eq. 14).
 
 For the step from step length sl_i to sl_(i+1), m intermediate step lengths are solved for RV and
 the m + 2 Boulic poses at the same phase are weighted by Bernstein polynomials of degree m + 1 in

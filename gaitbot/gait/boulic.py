@@ -1,8 +1,8 @@
-"""Boulic's free-walking model (seed 000 section 2.1; keyframes per docs/gait-model.md section 2).
+"""Boulic's free-walking model (Jing et al. 2015 section 2.1; keyframes per docs/gait-model.md section 2).
 
 Global level: relative velocity RV (speed / leg length) sets the cycle's relative length and
 phase durations. Joint level: hip, knee and ankle angles over a leg's own phase, given by
-keyframes joined with the zero-tangent cubic Hermite blend of seed 000, Appendix A.
+keyframes joined with the zero-tangent cubic Hermite blend of Jing et al. 2015, Appendix A.
 Everything here is vectorised over phase and, where it makes sense, over RV.
 """
 
@@ -13,31 +13,31 @@ import numpy as np
 REGION_A_MAX = 0.5  # RV regions A = [0, 0.5), B = [0.5, 1.3), C = [1.3, 3.0]
 REGION_B_MAX = 1.3
 REGION_C_MAX = 3.0
-TABLE2_CYCLE_S = 1.346  # seed 000, Table 2: Dc, fixed for the step-length control
+TABLE2_CYCLE_S = 1.346  # Jing et al. 2015, Table 2: Dc, fixed for the step-length control
 
 
 def relative_length(rv):
-    """RL = 1.346 sqrt(RV): cycle length over leg length (seed 000 eq. 1)."""
+    """RL = 1.346 sqrt(RV): cycle length over leg length (Jing et al. 2015 eq. 1)."""
     return 1.346 * np.sqrt(rv)
 
 
 def cycle_duration_s(rv):
-    """Dc = RL / RV seconds (seed 000 eq. 2) for a leg of length 1."""
+    """Dc = RL / RV seconds (Jing et al. 2015 eq. 2) for a leg of length 1."""
     return relative_length(rv) / rv
 
 
 def support_duration_s(cycle_s):
-    """Ds = 0.752 Dc - 0.143 (seed 000 eq. 3)."""
+    """Ds = 0.752 Dc - 0.143 (Jing et al. 2015 eq. 3)."""
     return 0.752 * cycle_s - 0.143
 
 
 def balance_duration_s(cycle_s):
-    """Db = 0.248 Dc + 0.143 (seed 000 eq. 4)."""
+    """Db = 0.248 Dc + 0.143 (Jing et al. 2015 eq. 4)."""
     return 0.248 * cycle_s + 0.143
 
 
 def double_support_duration_s(cycle_s):
-    """Dds = 0.252 Dc - 0.143 (seed 000 eq. 5)."""
+    """Dds = 0.252 Dc - 0.143 (Jing et al. 2015 eq. 5)."""
     return 0.252 * cycle_s - 0.143
 
 
@@ -80,7 +80,7 @@ def hermite_periodic(phase, key_phases: np.ndarray, key_values: np.ndarray):
     """Zero-tangent cubic Hermite blend between consecutive keyframes, wrapping at 1.0.
 
     theta(s) = theta_start (2s^3 - 3s^2 + 1) + theta_end (-2s^3 + 3s^2), s in [0, 1) between
-    two keyframes (seed 000 Appendix A). With a single keyframe the curve is constant.
+    two keyframes (Jing et al. 2015 Appendix A). With a single keyframe the curve is constant.
     """
     phase = np.asarray(phase, dtype=float) % 1.0
     n = len(key_phases)

@@ -1,6 +1,6 @@
 """Feet on the ground: a rolling sole, and the body's translation from the supporting foot.
 
-Seed 000 section 2.2 locks the supporting foot's heel, then its toe once the foot is parallel
+Jing et al. 2015 section 2.2 locks the supporting foot's heel, then its toe once the foot is parallel
 to the ground, and moves the root by the contact point's displacement (eq. 9). Using "the lower
 of heel and toe is the contact" (docs/gait-model.md section 3), that incremental rule has a closed
 form: a foot rolling without slip is fixed by one number, its *anchor* (the heel's x when the

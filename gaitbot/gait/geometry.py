@@ -17,8 +17,8 @@ class LegGeometry:
     """Lengths in metres (or leg lengths for the normalised human leg).
 
     thigh: hip to knee; shank: knee to ankle; foot: heel to toe along the sole;
-    ankle_height: ankle above the sole (0 for seed 000's leg, whose ankle lies on the sole);
-    heel_back: heel behind the ankle along the sole (0 for seed 000's leg: heel is the ankle
+    ankle_height: ankle above the sole (0 for Jing et al.'s leg, whose ankle lies on the sole);
+    heel_back: heel behind the ankle along the sole (0 for Jing et al.'s leg: heel is the ankle
     projected on the sole line); hip_width: lateral distance between the hips.
     """
 
@@ -57,7 +57,7 @@ class LegGeometry:
         return self.leg_length + self.ankle_height
 
 
-# Seed 000, Table 1: the reference human leg, leg length 1.0.
+# Jing et al. 2015, Table 1: the reference human leg, leg length 1.0.
 TABLE1_LEG = LegGeometry()
 
 

@@ -24,7 +24,7 @@ LEG_JOINTS = tuple(f"{kind}_{side}" for side in SIDES for kind in LEG_JOINT_KIND
 """Every leg joint gaitbot knows, in canonical order (12 names)."""
 
 PITCH_JOINTS = tuple(f"{kind}_{side}" for side in SIDES for kind in PITCH_KINDS)
-"""The joints of the sagittal-plane walker (seed 000's hip, knee and ankle), in canonical order."""
+"""The joints of the sagittal-plane walker (Jing et al.'s hip, knee and ankle), in canonical order."""
 
 _RANK = {name: i for i, name in enumerate(LEG_JOINTS)}
 

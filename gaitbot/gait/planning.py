@@ -1,6 +1,6 @@
 """Step plans: lengths from a distance, small random perturbations, and the per-step timetable.
 
-Seed 000 section 2.4 / docs/gait-model.md section 5: given a distance, the fewest equal steps that
+Jing et al. 2015 section 2.4 / docs/gait-model.md section 5: given a distance, the fewest equal steps that
 cover it; small random perturbations so that the walk does not look mechanical; left and right
 steps may differ (a plain list of step lengths expresses that).
 """

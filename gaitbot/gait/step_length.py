@@ -1,4 +1,4 @@
-"""Step length of the Boulic model and its inverse (seed 000 sections 2.3 and 4 of docs/gait-model.md).
+"""Step length of the Boulic model and its inverse (Jing et al. 2015 sections 2.3 and 4 of docs/gait-model.md).
 
 The realised step length is the distance between consecutive heel-strike points in the world.
 With the supporting foot rolling heel-then-toe without slipping, it follows exactly from the
@@ -60,7 +60,7 @@ def boulic_step_length(geometry: LegGeometry, rv, cycle_s: float = TABLE2_CYCLE_
 
 def step_length_to_rv_bisection(geometry: LegGeometry, step_length: float, tolerance: float = 0.01,
                                 cycle_s: float = TABLE2_CYCLE_S, max_iterations: int = 200) -> tuple[float, int]:
-    """Seed 000's Algorithm 1: bisect RV on [0, 0.5] until |SL - SL*| <= tolerance (geometry units).
+    """Jing et al.'s Algorithm 1: bisect RV on [0, 0.5] until |SL - SL*| <= tolerance (geometry units).
 
     Kept as the reference the fast inverse is tested against. Returns (rv, iterations).
     """
@@ -85,7 +85,7 @@ class StepLengthInverse:
 
     Build once per geometry and cycle (``StepLengthInverse.build``); ``rv(sl)`` then costs a
     table lookup and two or three exact SL evaluations to reach ``tolerance`` (default 1e-12
-    leg lengths). SL rises monotonically with RV in region A (seed 000, Appendix B); the build
+    leg lengths). SL rises monotonically with RV in region A (Jing et al. 2015, Appendix B); the build
     checks that on its grid for the given geometry and refuses a geometry where it fails.
     """
 

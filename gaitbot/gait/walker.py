@@ -1,4 +1,4 @@
-"""The walker of seed 000's Algorithm 2: frames every 1/rate s from a queue of step lengths.
+"""The walker of Jing et al.'s Algorithm 2: frames every 1/rate s from a queue of step lengths.
 
 The same segments serve both uses:
 - offline: ``generate_walk`` evaluates each segment on all its frames at once (vectorised);
@@ -8,7 +8,7 @@ The same segments serve both uses:
   which is the safe thing for a robot.
 
 A walk starts standing with feet together (zero step length), takes the queued steps, closes
-the trailing foot beside the leading one (a zero-length step) and stands (seed 000 section 2.4).
+the trailing foot beside the leading one (a zero-length step) and stands (Jing et al. 2015 section 2.4).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from .trajectory import HeelStrike, Trajectory
 class WalkSettings:
     """Gait settings; lengths in the geometry's unit (metres for a robot).
 
-    cycle_s: duration of a cycle (two steps), fixed as in seed 000 (Table 2: 1.346 s); rounded
+    cycle_s: duration of a cycle (two steps), fixed as in Jing et al. 2015 (Table 2: 1.346 s); rounded
     so that a step is a whole number of frames.
     clearance: least height of the whole swing sole from 20% to 80% of each swing.
     intermediate_steps: m of eq. 14, intermediate step lengths between consecutive steps.

@@ -200,7 +200,7 @@ def eigen_model_columns(model, mean_deg: np.ndarray, deltas_deg) -> tuple[list, 
 
 
 def plot_eigen_model(model_path, out: Path, n_show: int = 3) -> None:
-    """Eigen-motions of an eigen-gait model (seed 004 Fig. 3): per eigen-motion (rows), each joint's mean
+    """Eigen-motions of an eigen-gait model (Li et al. 2009 Fig. 3): per eigen-motion (rows), each joint's mean
     cycle (solid) and mean +- 2 sqrt(eigenvalue) times the eigen-motion (dashed +, dotted -), one column
     per joint kind the model moves, both legs in each. A joint that does not move in any example is left
     out and named in the title with its angle."""

@@ -30,7 +30,7 @@ def field_names(cls, *, without: tuple[str, ...] = ()) -> tuple[str, ...]:
 class Geometry:
     """Leg dimensions in metres: hip-knee, knee-ankle, foot length (heel to toe), distance between
     the hip joints, ankle axis above the sole, and heel behind the ankle axis (0: the heel is the
-    ankle projected on the sole, seed 000's foot). For 3D (gaitbot.gait.body): the sole's width
+    ankle projected on the sole, Jing et al.'s foot). For 3D (gaitbot.gait.body): the sole's width
     (None: not given; 3D robots must), its centre outward of the ankle, and the hip point below the
     root (the pelvis frame's origin)."""
 

@@ -1,4 +1,4 @@
-"""The margin every planned motion keeps under the servos' velocity and acceleration limits (issue 26).
+"""The margin every planned motion keeps under the servos' velocity and acceleration limits.
 
 A walk or a ramp is planned on a grid of equal periods, but goals go out at real send times: a frame held up
 by the host is followed by one sent sooner, and a recording judged at its send times (``gaitbot check``)
@@ -7,7 +7,7 @@ after a late frame measured 264 deg/s against op3's 240. So:
 
 - start ramps and stop ramps (gaitbot.robot.walk_settings.joint_limits_ticks) are planned at
   ``PLANNED_SHARE`` of each joint's ``max_velocity_dps`` and ``max_acceleration_dps2`` (walks themselves
-  are still planned and checked up to the full limits: issue 26 item 4 is open for them);
+  are still planned and checked up to the full limits);
 - the stream never sends two goal frames closer than ``MIN_SEND_INTERVAL_SHARE`` of a period
   (gaitbot.stream.pacing): after a stall the motion is stretched, never bunched to catch up, and regains
   the lost time at (1 - MIN_SEND_INTERVAL_SHARE) of a period a frame.

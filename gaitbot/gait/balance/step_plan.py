@@ -187,7 +187,7 @@ class StepPlanner:
 
     def step(self, blocks: PlanBlocks, state: PlanState, length_m: float) -> Landing:
         """A straight step: the swing foot lands ``length_m`` ahead of the stance foot, hip_width from the
-        midline (seed 000's step length, heel strike to heel strike)."""
+        midline (Jing et al.'s step length, heel strike to heel strike)."""
         stance = state.feet[state.stance_next]
         swing_side = "right" if state.stance_next == "left" else "left"
         new = FootPlacement(swing_side, stance.x_m + length_m, SIDE_SIGN[swing_side] * self.geometry.hip_width_m / 2)

@@ -1,8 +1,8 @@
 """The swing foot's path shape from the planar Boulic walker, tabulated per step length (docs/balance.md).
 
-Why: the balanced walk keeps the seed model's character: the swing foot's progression towards its
+Why: the balanced walk keeps the Boulic model's character: the swing foot's progression towards its
 foothold and its lift, as functions of swing time, are those the planar walker (gaitbot.gait.walker,
-seed 000) makes for that step length (its swing from toe-off to heel strike, relative to the stance
+Jing et al. 2015) makes for that step length (its swing from toe-off to heel strike, relative to the stance
 foot). The balanced walker scales them to its own footholds and clearance, with a flat sole (the ZMP
 plan needs flat feet). A planar step takes tens of milliseconds to plan, so the shapes are tabulated
 once per leg and cycle on a grid of step lengths and interpolated (appending a step stays cheap).

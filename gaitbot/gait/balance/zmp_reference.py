@@ -1,6 +1,6 @@
 """Step timing, footholds and the ZMP reference of a straight balanced walk (docs/balance.md).
 
-A step of length L lands the swinging foot L beyond the previous heel strike (seed 000's step length:
+A step of length L lands the swinging foot L beyond the previous heel strike (Jing et al.'s step length:
 heel strike to heel strike), the ankles hip_width apart. Each step is a whole number of frames
 (cycle / 2, rounded as the planar walker does): first a double support in which the ZMP reference moves
 smoothly (C2) from the old stance foot's reference point to the new one's, then a single support in

@@ -1,4 +1,4 @@
-"""Eigen-gaits (seed 004): functional PCA of example cycles, and synthesis from coefficients,
+"""Eigen-gaits (Li et al. 2009): functional PCA of example cycles, and synthesis from coefficients,
 step-length labels, or a required pose. Pure numpy/scipy; I/O only for the model ``.npz``."""
 
 from .example_cycles import ExampleCycle, ExampleError, cycles_from_trajectory, detect_heel_strikes, walk_label

@@ -1,4 +1,4 @@
-"""Seed 004 section 3 (1)-(2): resampling cycles to a common length, and DTW alignment to a reference.
+"""Li et al. 2009 section 3 (1)-(2): resampling cycles to a common length, and DTW alignment to a reference.
 
 A cycle is given as ``n`` frames at phases ``0, 1/n, ..., (n-1)/n`` of its duration (periodic: the
 frame at phase 1 is the next cycle's first). ``resample_cycle`` brings it to ``samples`` frames at
@@ -8,7 +8,7 @@ DTW (dynamic time warping) matches each frame of an example to frames of the ref
 Sakoe-Chiba band so a cycle is never warped by more than ``band`` of its length, with both ends
 matched to both ends. The alignment is kept as a *warp* ``h``: the aligned example at reference
 phase ``s`` is the original at phase ``h(s)`` (monotone, h(0) = 0, h(1) = 1). The model keeps
-the warps, so a synthesised cycle can be played back in real time (seed 004 section 6 (1)).
+the warps, so a synthesised cycle can be played back in real time (Li et al. 2009 section 6 (1)).
 """
 
 from __future__ import annotations

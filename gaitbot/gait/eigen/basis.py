@@ -1,11 +1,11 @@
-"""Functional bases on [0, 1] for seed 004 section 4.1: evaluation, Gram matrix W and roughness penalty R.
+"""Functional bases on [0, 1] for Li et al. 2009 section 4.1: evaluation, Gram matrix W and roughness penalty R.
 
 A motion channel x(s) is represented as ``Phi(s) @ c``. Least squares with a roughness penalty
 (Ramsay and Silverman ch. 5) minimises ``|x_hat - Phi c|^2 + lam * c^T R c`` with
-``R = int Phi''(s)^T Phi''(s) ds``, so ``c = (Phi^T Phi + lam R)^-1 Phi^T x_hat`` (seed 004 eq. 3 when
+``R = int Phi''(s)^T Phi''(s) ds``, so ``c = (Phi^T Phi + lam R)^-1 Phi^T x_hat`` (Li et al. 2009 eq. 3 when
 lam = 0). ``W = int Phi(s)^T Phi(s) ds`` is the Gram matrix of eq. 10.
 
-- ``FourierBasis``: for periodic cycles (seed 004: keeps the first and last poses continuous).
+- ``FourierBasis``: for periodic cycles (Li et al. 2009: keeps the first and last poses continuous).
   Orthonormal on [0, 1]: 1, sqrt2 cos(2 pi k s), sqrt2 sin(2 pi k s); W = I, R diagonal.
 - ``BSplineBasis``: for non-periodic motions; clamped cubic B-splines on equally spaced knots;
   W and R by Gauss-Legendre quadrature on each knot interval (exact for these polynomials).
@@ -102,7 +102,7 @@ def make_basis(kind: str, n_basis: int):
 
 
 def fit_coefficients(basis, s, values, roughness: float = 0.0) -> np.ndarray:
-    """Penalised least squares (seed 004 eq. 3 with a roughness penalty): values (n,) or (n, d) -> (K,) or (K, d)."""
+    """Penalised least squares (Li et al. eq. 3, with a roughness penalty): values (n,) or (n, d) -> (K,) or (K, d)."""
     phi = basis.evaluate(s)
     lhs = phi.T @ phi + roughness * basis.penalty()
     return np.linalg.solve(lhs, phi.T @ np.asarray(values, dtype=float))

@@ -1,4 +1,4 @@
-"""Example cycles from trajectory files (seed 004 section 3: cycle segmentation).
+"""Example cycles from trajectory files (Li et al. 2009 section 3: cycle segmentation).
 
 A cycle runs from a left heel strike to the next left heel strike (two steps, docs/gait-model.md
 section 1). Trajectory ``.npz`` files carry their heel strikes; CSV files (and recordings) do not,

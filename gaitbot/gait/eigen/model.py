@@ -1,6 +1,6 @@
-"""Eigen-gaits (seed 004): fit a functional-PCA model to example cycles, save/load it, synthesise cycles.
+"""Eigen-gaits (Li et al. 2009): fit a functional-PCA model to example cycles, save/load it, synthesise cycles.
 
-Fit (``fit_model``), following seed 004:
+Fit (``fit_model``), following Li et al. 2009:
 1. each cycle is resampled to ``samples`` frames (section 3 (2)) and DTW-aligned to a reference,
    the example whose label is the median (section 3 (1)); the warps are kept (see align.py);
 2. PCA of all aligned poses; the leading axes U explaining ``pose_variance`` (default 95%) are
@@ -447,7 +447,7 @@ def is_model_file(path: str | Path) -> bool:
 def fit_model(examples: list[ExampleCycle], geometry: LegGeometry, rate_hz: float,
               options: FitOptions = FitOptions(), periodic: bool = True, robot: str = "",
               on_progress=None, legs=None) -> EigenGaitModel:
-    """Seed 004 sections 3 and 4 on example cycles (see the module docstring). ``geometry`` is the leg that
+    """Li et al. 2009 sections 3 and 4 on example cycles (see the module docstring). ``geometry`` is the leg that
     walked the examples and ``robot`` the robot they are for: the model keeps both, and synthesis for
     another leg or robot is refused (app/eigen.py). ``legs`` (legs.py; default the planar legs of
     ``geometry``) says which joints the cycles' columns are and how the root follows them. ``on_progress(k,

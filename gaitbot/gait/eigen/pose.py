@@ -1,4 +1,4 @@
-"""Pose PCA (seed 004 section 3 (3), eq. 1), with the number of axes chosen for a robot.
+"""Pose PCA (Li et al. 2009 section 3 (3), eq. 1), with the number of axes chosen for a robot.
 
 The paper keeps the leading axes holding 95% of the pose variance (72 degrees of freedom down to
 15). A walking robot has six, and the 5% left out is not noise: on the shipped biped's flat walks
@@ -35,7 +35,7 @@ class PosePCA:
 
 
 def leading_count(eigenvalues: np.ndarray, share: float) -> int:
-    """Smallest count whose eigenvalues hold at least ``share`` of the total (seed 004 eq. 11)."""
+    """Smallest count whose eigenvalues hold at least ``share`` of the total (Li et al. 2009 eq. 11)."""
     total = eigenvalues.sum()
     if total <= 0:
         return 1

@@ -1,9 +1,9 @@
 """From eigen-gait coefficients to a walk: cycles in real time, joined to a start and a stop, and the
-root from foot contact (seed 004 section 6; docs/gait-model.md section 3).
+root from foot contact (Li et al. 2009 section 6; docs/gait-model.md section 3).
 
 Choices (stated once):
 - The model only knows steady cycles (left heel strike to left heel strike). A walk therefore
-  starts and ends as the walker's do: the walker (seed 000, Algorithm 2) takes the robot from
+  starts and ends as the walker's do: the walker (Jing et al. 2015, Algorithm 2) takes the robot from
   standing through its first step to the first left heel strike; the synthesised cycles follow;
   the walker's closing step, settle and stand end it. Joint angles and velocities are made
   continuous at both joins by a quintic correction that fades over ``blend_cycles`` of a cycle
@@ -14,7 +14,7 @@ Choices (stated once):
   quarter cycle instead took the last synthesised swing 7 mm lower, below the configured clearance.
 - Transitions: the label (or the coefficients) is interpolated linearly from cycle to cycle, and
   within a cycle the coefficients go linearly from the cycle's start value to its end value, so
-  the motion is continuous (seed 004 section 7, Figs. 8 and 9).
+  the motion is continuous (Li et al. 2009 section 7, Figs. 8 and 9).
 - Root: the contact model of the robot's walker, from the angles alone (legs.py): for the planar
   walker the stance foot rolls without slip about its lowest sole point and the root follows it in
   closed form (gait/footfall.py ``root_from_contact``, also used by ``gaitbot record``); for the

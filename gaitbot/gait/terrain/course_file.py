@@ -9,7 +9,7 @@
     # max_step_m = 0.16    longest step onto another surface (default 0.75 leg lengths)
     # max_rise_m = 0.05    highest rise or drop between footholds (default 0.25 leg lengths)
 
-    [search]             # optional: the grid search of the pelvis's lowest points (seed 003)
+    [search]             # optional: the grid search of the pelvis's lowest points (Zhang 2008)
     weights = [1.0, 1.0, 0.8]   # hip, knee, ankle (default: the joints' ranges, normalised)
 
     [[tread]]

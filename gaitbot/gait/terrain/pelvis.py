@@ -1,4 +1,4 @@
-"""The pelvis path of seed 003: cubic Bezier segments between knots in time.
+"""The pelvis path of Zhang 2008: cubic Bezier segments between knots in time.
 
 Knots are the mid-stance points (MS: the pelvis over the stance ankle, highest), the
 mid-double-support points (MDS: lowest, chosen by the grid search), and the ends of a run of
@@ -24,7 +24,7 @@ def bernstein(n: int, s) -> np.ndarray:
 
 
 def bezier(control, s) -> np.ndarray:
-    """Points of the Bezier curve with control points (n + 1, d) at parameters s: (m, d) (seed 003 eq. 1-3)."""
+    """Points of the Bezier curve with control points (n + 1, d) at parameters s: (m, d) (Zhang 2008 eq. 1-3)."""
     control = np.asarray(control, dtype=float)
     return bernstein(len(control) - 1, s) @ control
 

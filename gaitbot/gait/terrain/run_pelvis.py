@@ -1,4 +1,4 @@
-"""The pelvis of a run of consecutive terrain steps (seed 003): Bezier segments through MS and MDS points.
+"""The pelvis of a run of consecutive terrain steps (Zhang 2008): Bezier segments through MS and MDS points.
 
 Knots, in time order: the hand-over from the segment before (position and velocity, so joint
 velocities stay continuous), then per step its mid-double-support point (MDS, lowest, chosen by the
@@ -8,9 +8,9 @@ at the run's last heel strike, from which the next segment takes over.
 - MS: the highest pelvis point at mid-swing from which both legs fit (``legs.LegRange`` with a
   spare margin), no higher than the stance knee bent MS_KNEE_RAD (MS_KNEE_DOWN_RAD on a step
   down), preferring a point midway between the stance ankle and the middle of the swing path; a
-  few such candidates, tried in turn (``_ms_candidates``). On level ground that is seed 003's MS;
+  few such candidates, tried in turn (``_ms_candidates``). On level ground that is Zhang's MS;
   on a stair it drops or moves where the swing foot still lies far behind or below.
-- MDS: seed 003's search over the region between the two neighbouring knots (``_mds_region``),
+- MDS: Zhang's search over the region between the two neighbouring knots (``_mds_region``),
   scoring a cell by the supporting legs' weighted squared joint accelerations over the two Bezier
   segments it shapes (``MdsProblem``); a cell whose MDS pose the legs cannot reach is skipped,
   and a cell whose path leaves the legs' ranges or moves the pelvis backward scores INFEASIBLE
@@ -62,7 +62,7 @@ def _slope(a: Knot, b: Knot) -> float:
 
 @dataclass(frozen=True)
 class MdsProblem:
-    """One MDS point's search: the region and the functions seed 003's grid search needs.
+    """One MDS point's search: the region and the functions Zhang's grid search needs.
 
     ``cost(point)`` is the supporting legs' weighted squared joint accelerations (inf where the
     path is infeasible); ``reachable(point)`` the cheap test at the MDS pose itself."""
@@ -170,7 +170,7 @@ class TerrainRun:
 
     # --- knots ---------------------------------------------------------------------------------------
     def _ms_candidates(self, seg: TerrainStepSegment) -> list[Knot]:
-        """Seed 003's MS at mid-swing: the highest point from which the stance leg reaches its foot and the
+        """Zhang's MS at mid-swing: the highest point from which the stance leg reaches its foot and the
         swing leg some point of its path with room to spare. Where along x: first choice midway between
         the stance ankle and the middle of the swing path (over the stance foot when the feet pass each
         other, as on flat ground; ahead of it on a step-to's leading step, behind on its closing step),
@@ -252,9 +252,9 @@ class TerrainRun:
         raise GaitGenerationError(f"{seg.what}: no pelvis path from mid-stance to the heel strike lets both legs "
                                   f"reach their feet within the joint limits (rise or step too large for this leg)")
 
-    # --- seed 003's search -------------------------------------------------------------------------
+    # --- Zhang's search -------------------------------------------------------------------------
     def _mds_region(self, prev: Knot, nxt: Knot, at_mds):
-        """Seed 003's region between the two MS points (x between them, y from MDS_DEPTH_SHARE leg lengths
+        """Zhang's region between the two MS points (x between them, y from MDS_DEPTH_SHARE leg lengths
         below the lower up to MDS_ABOVE_SHARE above the higher: with bent knees the cheapest pelvis often
         barely dips, and a best point on the region's edge is one a grid of centres sees badly),
         cropped to the box around the part of it from which both legs reach their feet at the MDS
@@ -283,7 +283,7 @@ class TerrainRun:
         A cell is feasible if the supporting legs fit all along its two Bezier segments, the swing that
         ends inside them (the previous step's) finds a timing that keeps its leg in range over its whole
         swing, and the swing that starts inside them (this step's) finds one up to mid-swing. Its cost
-        is seed 003's: the supporting legs' weighted squared joint accelerations. An infeasible cell
+        is Zhang's: the supporting legs' weighted squared joint accelerations. An infeasible cell
         scores INFEASIBLE scaled up by how far it is from feasible, so where the feasible set is a thin
         sliver the search still homes in on it. The chosen cell fixes the previous swing's timing."""
         seg = self.segments[k]

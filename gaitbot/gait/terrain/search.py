@@ -1,4 +1,4 @@
-"""The two-level grid search of seed 003 for a mid-double-support (MDS) pelvis point.
+"""The two-level grid search of Zhang 2008 for a mid-double-support (MDS) pelvis point.
 
 The region (a rectangle between two mid-stance points) is split into 5 x 5 cells and each cell
 centre is scored; cells the legs cannot reach are skipped before scoring (a cheap test at the
@@ -52,7 +52,7 @@ def _score(points, cost: Callable, reachable: Callable):
 
 
 def two_level_search(region: Region, cost: Callable, reachable: Callable, n: int = 5, follow: int = 1) -> SearchResult:
-    """Seed 003's search: ``cost(point)`` -> float (inf if infeasible), ``reachable(point)`` -> bool (cheap).
+    """Zhang's search: ``cost(point)`` -> float (inf if infeasible), ``reachable(point)`` -> bool (cheap).
 
     Level one scores the n x n cell centres of the region; level two splits the best cell n x n
     again and scores those. Where the best of the second level lies in the outer ring of its cell,

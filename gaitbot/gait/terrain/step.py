@@ -1,4 +1,4 @@
-"""One terrain step (seed 003): both feet in the world, the legs by IK from a pelvis path.
+"""One terrain step (Zhang 2008): both feet in the world, the legs by IK from a pelvis path.
 
 A step runs from one heel strike to the next, in two parts of its progress u:
 

@@ -1,10 +1,10 @@
-"""A walk over a terrain: the flat walker's segments on level ground, seed 003's elsewhere.
+"""A walk over a terrain: the flat walker's segments on level ground, Zhang's elsewhere.
 
 Steps whose three footholds (rear, stance, target) lie on one surface with no edge between
 are the flat walker's ``StepSegment`` (the Boulic style), lifted to that surface's height by
 ``LevelSegment``. Every other step is a ``TerrainStepSegment`` (step.py: feet in the world,
 swing.py: the swing foot's path), and consecutive terrain steps form a ``TerrainRun`` (run_pelvis.py:
-seed 003's Bezier pelvis through MS and MDS points, the MDS points chosen by the two-level grid
+Zhang's Bezier pelvis through MS and MDS points, the MDS points chosen by the two-level grid
 search). Every leg angle of a terrain step comes from 2-link IK, pelvis to ankle.
 
 A run's pelvis path starts from the state the previous segment handed over (position and
@@ -40,7 +40,7 @@ class TerrainSettings:
     """How to walk a terrain. Lengths in metres, angles in radians.
 
     envelope: what one step can do between surfaces (envelope.py). weights: the search cost's
-    weights of hip, knee and ankle (seed 003: by default the joints' ranges normalised to the
+    weights of hip, knee and ankle (Zhang 2008: by default the joints' ranges normalised to the
     largest). joint_lo/joint_hi: the leg's joint limits (hip, knee, ankle), or None for no limits
     besides reach; joint_speed/joint_accel likewise for the joints' speed and acceleration limits.
     """
@@ -56,7 +56,7 @@ class TerrainSettings:
 
 
 def default_weights(joint_lo, joint_hi) -> tuple[float, float, float]:
-    """Seed 003's default weights: each joint's range over the largest range."""
+    """Zhang's default weights: each joint's range over the largest range."""
     if joint_lo is None or joint_hi is None:
         return (1.0, 1.0, 1.0)
     ranges = np.asarray(joint_hi) - np.asarray(joint_lo)
@@ -102,7 +102,7 @@ class TerrainStep:
     end_s: float
     foothold_m: float
     height_m: float
-    method: str  # "flat" (the Boulic walker) or "terrain" (seed 003)
+    method: str  # "flat" (the Boulic walker) or "terrain" (Zhang 2008)
     lift_m: float
     closing: bool = False
 
