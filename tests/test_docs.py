@@ -69,3 +69,13 @@ def test_the_index_sorts_every_page_by_kind():
     assert len(sections) == 4, [s.splitlines()[0] for s in sections]
     linked = [target for section in sections for target in re.findall(r"\]\(([\w-]+\.md)\)", section)]
     assert sorted(linked) == sorted(p.name for p in DOCS if p.name != "README.md")
+
+
+def test_papers_are_named_by_their_authors_and_no_issue_numbers_reach_a_user():
+    """A reader cannot look up "seed 003" or "issue 15": the papers go by their authors (docs/gait-model.md,
+    "The papers"), and the project's own tracker numbers stay out of what a user reads or runs."""
+    unreadable = re.compile(r"\bseeds? 00\d|\bissue #?\d", re.I)
+    sources = [*PAGES, *(REPO_ROOT / "gaitbot").rglob("*.py"), *(REPO_ROOT / "tools").glob("*.py")]
+    found = [f"{path.relative_to(REPO_ROOT)}:{number}: {line.strip()}" for path in sources
+             for number, line in enumerate(path.read_text().splitlines(), start=1) if unreadable.search(line)]
+    assert not found, "\n".join(found)

@@ -1,6 +1,6 @@
 """The balanced op3 walk on robots that differ from the one it was planned for: the robustness table.
 
-    python tools/robustness.py            # the whole table (docs/balance.md quotes it), about 2 minutes
+    python tools/robustness.py            # the whole table (docs/balance-robustness.md quotes it), about 2 minutes
     python tools/robustness.py --quick    # the subset tests/sim/test_sim_balance.py runs
     python tools/robustness.py --json     # one JSON object per row
     python tools/robustness.py --robot bioloid   # the same for the BIOLOID Type A (its own walks, no Menagerie)
@@ -55,7 +55,7 @@ WALKS = {
 }
 #: The bioloid's walks: the op3's scaled by leg length (0.149 / 0.220 m, about 0.7): varied 3 +- 0.7 cm,
 #: asymmetric 3.5 / 2 cm (its max_step_m and 0.6 of it, as the op3's 5 / 3 cm), and its fastest walk
-#: that meets the targets (docs/balance.md, "The bioloid").
+#: that meets the targets (docs/balance-robustness.md, "The bioloid").
 BIOLOID_WALKS = {
     "2 m": ["--distance", "2"],
     "2 m varied (3 +- 0.7 cm)": ["--distance", "2", "--max-step", "0.03", "--perturb", "0.007", "--seed", "1"],
@@ -249,7 +249,7 @@ def main(argv=None) -> int:
     parser.add_argument("--json", action="store_true", help="one JSON object per row")
     parser.add_argument("--robot", default="op3", choices=("op3", "bioloid"), help="whose table (default op3)")
     parser.add_argument("--markdown", action="store_true",
-                        help="both robots' whole tables as the figures of docs/balance.md (tools/figures.py)")
+                        help="both robots' whole tables as the figures of docs/balance-robustness.md (tools/figures.py)")
     args = parser.parse_args(argv)
     import_mujoco()
     if args.markdown:
