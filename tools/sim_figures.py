@@ -43,7 +43,7 @@ OP3_WALKS = (
 )
 #: The balanced bioloid walks of docs/simulation.md: the op3's scaled to its legs (0.149 / 0.220 m), its
 #: fastest walk within the AX-12A's 300 deg/s, pushes of the op3's velocity change (0.34 N s), the largest
-#: it survives both ways (0.65) and the op3's 0.7 N s (docs/balance.md, "The bioloid").
+#: it survives both ways (0.65) and the op3's 0.7 N s (docs/balance-robustness.md, "The bioloid").
 BIOLOID_WALKS = (
     ("`--distance 2`", ["--distance", "2"]),
     ("`--distance 2 --max-step 0.03 --perturb 0.007 --seed 1` (varied)",

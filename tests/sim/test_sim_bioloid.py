@@ -2,7 +2,7 @@
 3D simulation, through the real CLI (``gaitbot walk --sim --json --robot bioloid``: the goals as servo ticks
 through the Protocol 1.0 packets), judged by issue 15's targets as the op3 is (``meets_the_targets``).
 
-Its walks are the op3's scaled to its legs (docs/balance.md, "The bioloid"): varied 3 +- 0.7 cm steps,
+Its walks are the op3's scaled to its legs (docs/balance-robustness.md, "The bioloid"): varied 3 +- 0.7 cm steps,
 asymmetric 3.5 / 2 cm, its fastest walk within the AX-12A's 300 deg/s, and a mid-step push of 0.34 N s
 (the op3's 0.7 N s scaled by mass: the same sideways velocity change) both ways.
 """
@@ -23,7 +23,7 @@ except SimUnavailable:
 from gaitbot.app.cli import main  # noqa: E402
 from test_sim_balance import meets_the_targets  # noqa: E402
 
-#: The bioloid's fastest walk that meets the targets (docs/balance.md, "The bioloid": the speed fit's peak
+#: The bioloid's fastest walk that meets the targets (docs/balance-robustness.md, "The bioloid": the speed fit's peak
 #: joint speed stays under the AX-12A's 300 deg/s); the op3's 0.8 s / 8 cm is refused before anything moves.
 FAST = ["--distance", "2", "--cycle", "0.8", "--max-step", "0.05"]
 

@@ -1,7 +1,7 @@
 """The balanced walk's settings (a robot config's optional ``[balance]`` table), with why each matters.
 
 The defaults are the operating point found for the ROBOTIS OP3 in the free-floating simulation and
-checked on other people's models of it (docs/balance.md gives the sweep and the robustness table).
+checked on other people's models of it (docs/balance.md gives the sweep, docs/balance-robustness.md the robustness table).
 """
 
 from __future__ import annotations
