@@ -1,6 +1,6 @@
 """The mapping file of ``--sim-map``: which joint of another author's MuJoCo model is which gaitbot joint.
 
-The form (docs/simulation.md, "Other people's robot models")::
+The form (docs/compare-models.md, "Other people's robot models")::
 
     [joints]              # gaitbot joint = the model's joint name; a leading "-" flips the sign
     hip_pitch_left = "-l_hip_pitch"
