@@ -79,3 +79,14 @@ def test_papers_are_named_by_their_authors_and_no_issue_numbers_reach_a_user():
     found = [f"{path.relative_to(REPO_ROOT)}:{number}: {line.strip()}" for path in sources
              for number, line in enumerate(path.read_text().splitlines(), start=1) if unreadable.search(line)]
     assert not found, "\n".join(found)
+
+
+MAX_PAGE_WORDS = 3500
+"""A page a reader finishes in one sitting: about a quarter of an hour at a technical reader's pace. A page
+that grows past it splits by what its reader needs (docs/README.md's kinds)."""
+
+
+def test_each_page_is_read_in_one_sitting():
+    long_pages = {page.name: len(page.read_text().split()) for page in PAGES}
+    assert all(words <= MAX_PAGE_WORDS for words in long_pages.values()), \
+        {name: words for name, words in long_pages.items() if words > MAX_PAGE_WORDS}
