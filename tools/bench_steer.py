@@ -43,7 +43,7 @@ def main(argv=None) -> int:
     k = 0
     while k < args.seconds * rate:
         t0 = time.perf_counter()
-        queued_s = walker.plan_arrays()["zmp"].shape[0] / rate - k / rate
+        queued_s = walker.planned_frames / rate - k / rate
         added = False
         if queued_s < LOOKAHEAD_S:
             command = VelocityCommand(*COMMANDS[int(k / rate / 6.0) % len(COMMANDS)])

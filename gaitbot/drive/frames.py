@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gaitbot.drive.guard import FrameGuard
-from gaitbot.drive.spread import SpreadReplan
 from gaitbot.gait.joints import LEG_JOINTS
 from gaitbot.gait.steer.command import STILL, TimedCommand, VelocityCommand
 from gaitbot.gait.steer.planner import frame_of, leading_side
@@ -113,7 +112,6 @@ class DriveFrames:
     def _new_walker(self) -> None:
         """A walker standing where the drive stands (its own world; the odometry composes it)."""
         self._walker = balanced_walker(self.config, self.gait)
-        self._spread = SpreadReplan(self._walker)
         self._next_step = None
         self._planner = footstep_planner(self.config, self.gait)
         self._origin = frame_of(self._walker.feet)
@@ -135,7 +133,7 @@ class DriveFrames:
             self._started = True
             self._walker_k0 = self.k
         self._plan_ahead()
-        self._spread.work()
+        walker.work()  # a share of the last append's replan (BalancedWalker.work)
         frame = walker.next_frame()
         if frame is None:  # the walker has closed its feet and lowered to standing
             self._close_walker()
@@ -225,7 +223,7 @@ class DriveFrames:
 
     def _append(self, step) -> None:
         walker = self._walker
-        walker.append_footstep(step.foothold, max(0.0, step.length_m))
+        walker.append_footstep(step.foothold, max(0.0, step.length_m), spread=True)
         if self._changed_s is not None:  # the first step planned since the command changed
             start_s = self._walker_k0 * self.period_s + walker.planned_steps[-1].start_s
             self.log.latencies_s.append(start_s - self._changed_s)

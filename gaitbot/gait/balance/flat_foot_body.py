@@ -92,7 +92,8 @@ class FlatFootBody:
 
     def gravity_torques(self, q, share_left: float, cops) -> list[float]:
         """As MassModel.gravity_torques for one frame: the 12 joint torques (N m) holding the pose;
-        cops[side index] = (x, y) of each foot's centre of pressure in the root frame."""
+        cops[side index] = (x, y) of each foot's centre of pressure in the root frame; a turned foot (hip yaw
+        q[0] or q[6] not 0) turns its leg's links and joint axes about the hip."""
         g = GRAVITY_M_S2
         weight = self.total_kg * g
         out = []
@@ -104,6 +105,14 @@ class FlatFootBody:
             cr, sr = math.cos(s * leg[1]), math.sin(s * leg[1])
             b5 = -leg[2] + leg[3] - leg[4]
             axes = ((0.0, 0.0), (s, 0.0), (0.0, -cr), (0.0, cr), (0.0, -cr), (s * math.cos(b5), s * sr * math.sin(b5)))
+            if leg[0] != 0.0:  # the hip yaw joint turns the rest of the leg (points and axes) about the hip
+                cg, sg = math.cos(s * leg[0]), math.sin(s * leg[0])
+                hx, hy, _ = self.hips[side]
+                points = [(hx + cg * (px - hx) - sg * (py - hy), hy + sg * (px - hx) + cg * (py - hy), pz)
+                          for px, py, pz in points]
+                knee, ankle = ((hx + cg * (px - hx) - sg * (py - hy), hy + sg * (px - hx) + cg * (py - hy), pz)
+                               for px, py, pz in (knee, ankle))
+                axes = tuple((cg * ax - sg * ay, sg * ax + cg * ay) for ax, ay in axes)
             joints = (self.hips[side], self.hips[side], self.hips[side], knee, ankle, ankle)
             fx, fy = cops[i]
             for j in range(6):
