@@ -132,8 +132,8 @@ class DriveFrames:
             walker.lead_with(leading_side(self.command))
             self._started = True
             self._walker_k0 = self.k
-        self._plan_ahead()
-        walker.work()  # a share of the last append's replan (BalancedWalker.work)
+        if not self._plan_ahead():  # a frame that appends a step leaves the replan's share for the next
+            walker.work()  # a share of the last append's replan (BalancedWalker.work)
         frame = walker.next_frame()
         if frame is None:  # the walker has closed its feet and lowered to standing
             self._close_walker()
@@ -177,29 +177,32 @@ class DriveFrames:
         if self.on_command is not None:
             self.on_command(timed)
 
-    def _plan_ahead(self) -> None:
+    def _plan_ahead(self) -> bool:
         """At most one step a frame, while fewer than queue_steps planned steps have not started; a step is
-        planned and checked in one frame and handed to the walker in the next (spreading the work)."""
+        planned and checked in one frame and handed to the walker in the next (spreading the work).
+        Returns whether a step was handed to the walker."""
         walker, planner = self._walker, self._planner
         if self._next_step is not None:
             step, self._next_step = self._next_step, None
             if not (walker.finished or self.ending):
                 self._append(step)
-            return
+                return True
+            return False
         if walker.finished or self.ending:
-            return
+            return False
         if self.command.is_still and planner.standing():
-            return
+            return False
         now_s = walker._out / walker.rate_hz
         pending = sum(1 for s in walker.planned_steps[-self.queue_steps - 1:] if s.start_s >= now_s)
         if pending >= self.queue_steps:
-            return
+            return False
         side = walker.next_swing_side
         step = self._checked_step(side, self.command)
         if step is None:  # even slowing down would not keep the soles apart: no more steps
             self.ending = True
-            return
+            return False
         self._next_step = step
+        return False
 
     def _checked_step(self, side: str, command: VelocityCommand):
         """The planner's next step, its soles' swept gap checked again; a step that fails is replaced by a

@@ -177,8 +177,8 @@ class FloatPreview:
         n = len(self.f)
         if count == 1:
             return (self.f @ padded[start + 1:start + 1 + n])[None]
-        window = np.lib.stride_tricks.sliding_window_view(padded[start + 1:start + count + n], n, axis=0)
-        return window @ self.f
+        part = padded[start + 1:start + count + n]
+        return np.column_stack([np.correlate(part[:, 0], self.f), np.correlate(part[:, 1], self.f)])
 
     def step(self, rx: float, ry: float, px: float, py: float) -> None:
         x0, x1, x2, y0, y1, y2, ex, ey = self.state

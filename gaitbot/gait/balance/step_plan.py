@@ -66,6 +66,9 @@ def swing_yaw_share(position_share):
     """The share of its turn the swing foot has made when its ankle point is ``position_share`` of the way
     to its foothold (0 -> 1 over YAW_WINDOW)."""
     a, b = YAW_WINDOW
+    if isinstance(position_share, float):  # one share (the sole sweep's hot path): the same arithmetic in floats
+        u = min(max((position_share - a) / (b - a), 0.0), 1.0)
+        return u * u * u * (u * (6 * u - 15) + 10)
     return smootherstep((np.asarray(position_share, dtype=float) - a) / (b - a))
 
 

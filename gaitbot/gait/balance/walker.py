@@ -454,8 +454,12 @@ class BalancedWalker:
     def _refresh_errors(self, first: int, last: int) -> None:
         """The second stage's multibody ZMP error at frames first..last, those already computed."""
         last = min(last, self._err_next - 1, self._last_frame())
-        if last < first:
-            return
+        if first <= last:
+            self._errors(first, last)
+
+    def _errors(self, first: int, last: int) -> None:
+        """Multibody (point-mass) ZMP minus the reference at frames first..last (at most the last frame), at
+        once: the points of frames first - 1..last + 1 (the walk's ends repeated, as the offline padding)."""
         end = self._last_frame()
         window = np.array([self._points(i) for i in range(max(first - 1, 0), min(last + 1, end) + 1)])
         if first == 0:
@@ -470,24 +474,21 @@ class BalancedWalker:
         return self._s1_points[max(0, min(j, self._last_frame()))]
 
     def _zmp_errors_until(self, j: int) -> None:
-        """Multibody (point-mass) ZMP minus the reference for frames up to j (frames past the end: the
-        last frame's, as the offline padding)."""
+        """Multibody ZMP errors for the frames up to j not computed yet (frames past the end: the last
+        frame's, as the offline padding)."""
+        if self._err_next > j:
+            return
         b = self._base
         if len(self._err) <= j - b:
             grown = np.zeros((max(2 * len(self._err), j - b + 1), 2))
             grown[:self._err_next - b] = self._err[:self._err_next - b]
             self._err = grown
         last = self._last_frame()
-        masses, dt = self.whole.point_masses_kg, 1.0 / self.rate_hz
-        while self._err_next <= j:
-            i = min(self._err_next, last)
-            if i < self._err_next:
-                self._err[self._err_next - b] = self._err[i - b]
-            else:
-                window = np.array([self._points(i - 1 if i > 0 else 0), self._points(i),
-                                   self._points(i + 1 if i < last else i)])
-                self._err[i - b] = multibody_zmp(window, masses, dt)[0] - self._ext_at("zmp", i)
-            self._err_next += 1
+        if self._err_next <= min(j, last):
+            self._errors(self._err_next, min(j, last))
+        if j > last:
+            self._err[max(self._err_next, last + 1) - b:j - b + 1] = self._err[last - b]
+        self._err_next = j + 1
 
     def next_frame(self):
         """(t_s, q_rad (12,), goal_rad (12,), root_m (3,)) of the next frame, or None after the last."""
@@ -517,7 +518,9 @@ class BalancedWalker:
         if not self._primed:
             self._prime()
         ahead = self.gains.horizon_frames + 2
-        self._stage1_until(math.ceil((j + 1) * ahead / self.rise_frames) - 1)
+        until = math.ceil((j + 1) * ahead / self.rise_frames) - 1
+        self._stage1_until(until)
+        self._zmp_errors_until(min(until - 1, self.gains.horizon_frames))
 
     def _balance_frame(self):
         """The balance plan's next frame: (q, goal, root), or None after its last."""
