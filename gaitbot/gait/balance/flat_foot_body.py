@@ -33,6 +33,7 @@ class FlatFootBody:
         self.link_kg = [body.leg_links[n].mass_kg for n in LEG_LINKS]
         self.link_com = {s: [tuple(float(v) for v in body.leg_link(n, s).com_m) for n in LEG_LINKS] for s in SIDES}
         self.total_kg = self.torso_kg + 2 * sum(self.link_kg)
+        self._last_q, self._last_points = None, []
 
     def leg_ik(self, side: str, rx: float, ry: float, rz: float, gamma: float = 0.0) -> list[float]:
         """One leg's six angles for r = hip - ankle (root frame); the foot flat, turned by gamma (rad)
@@ -148,9 +149,12 @@ class FlatFootBody:
 
     def world_points(self, root, q, yaws=None) -> list[tuple[float, float, float]]:
         """The torso's and the 12 leg links' CoMs in the world (the torso turned by the feet's mean yaw)."""
-        local = [self.torso_com]
-        for k, side in enumerate(SIDES):
-            local += self.link_points(side, q[6 * k:6 * k + 6])
+        if self._last_q is q:  # the placement's last pose (com_in_root has the points)
+            local = [self.torso_com] + self._last_points
+        else:
+            local = [self.torso_com]
+            for k, side in enumerate(SIDES):
+                local += self.link_points(side, q[6 * k:6 * k + 6])
         psi = 0.0 if yaws is None else 0.5 * (yaws[0] + yaws[1])
         if psi == 0.0:
             return [(root[0] + p[0], root[1] + p[1], root[2] + p[2]) for p in local]
@@ -160,11 +164,12 @@ class FlatFootBody:
     def com_in_root(self, q) -> tuple[float, float, float]:
         m = self.torso_kg
         x, y, z = (m * c for c in self.torso_com)
-        for i, side in enumerate(SIDES):
-            for kg, (px, py, pz) in zip(self.link_kg, self.link_points(side, q[6 * i:6 * i + 6])):
-                x += kg * px
-                y += kg * py
-                z += kg * pz
+        points = self.link_points("left", q[0:6]) + self.link_points("right", q[6:12])
+        for kg, (px, py, pz) in zip(self.link_kg + self.link_kg, points):
+            x += kg * px
+            y += kg * py
+            z += kg * pz
+        self._last_q, self._last_points = q, points  # world_points of the same pose reuses them
         return x / self.total_kg, y / self.total_kg, z / self.total_kg
 
     def place(self, com_x: float, com_y: float, ankles, root_z: float, guess_dx: float, guess_dy: float,

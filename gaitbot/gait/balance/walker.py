@@ -30,7 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from gaitbot.gait.balance.flat_foot_body import FlatFootBody
-from gaitbot.gait.balance.placement import (MAX_PLACEMENT_ITERATIONS, PLACEMENT_TOLERANCE_M, WholeBody,
+from gaitbot.gait.balance.placement import (MAX_PLACEMENT_ITERATIONS, PLACEMENT_TOLERANCE_M, SLOPE_PROBE_M,
+                                            WholeBody,
                                             multibody_zmp, to_world, torso_yaw)
 from gaitbot.gait.balance.preview import FloatPreview, preview_gains, preview_offline
 from gaitbot.gait.balance.settings import BalanceSettings
@@ -46,9 +47,9 @@ from gaitbot.gait.walk_segments import GaitGenerationError
 from gaitbot.gait.trajectory import HeelStrike, Trajectory
 
 STEP_LENGTH_TOLERANCE_M = 1e-12
-SPREAD_FRAMES = 4
+SPREAD_FRAMES = 6
 """Body placements ``BalancedWalker.work`` redoes per call by default (the float code: ~0.1 ms each on the
-development machine): a replan of the 1 s preview horizon is spread over ~16 frames."""
+development machine): a replan of the 1 s preview horizon is spread over ~11 frames."""
 VECTORISED_FRAMES = 16
 """From this many frames on, a re-placement runs vectorised (numpy) rather than frame by frame in floats."""
 STORED_FRAMES = 1200
@@ -334,6 +335,7 @@ class BalancedWalker:
         self._ext = self._arrays if closed else {key: a[d:].copy() for key, a in self._ext.items()}
         self._zmp_padded = self._zmp_padded[d:].copy()
         self._err = self._err[d:].copy()
+        self._pts = self._pts[d:].copy()
         self._base = cut
 
     def _last_frame(self) -> int:
@@ -347,11 +349,25 @@ class BalancedWalker:
         self._stage2 = FloatPreview(self.gains, np.zeros(2))
         self._s1_next = 0
         self._s1_offset = tuple(self.standing_offset)
-        self._s1_com, self._s1_points, self._s1_snapshot, self._s1_offsets = {}, {}, {}, {}
-        self._err, self._err_next = np.zeros((256, 2)), 0
+        self._s1_com, self._s1_snapshot, self._s1_offsets = {}, {}, {}
+        self._err, self._err_next = np.zeros((256, 2)), 0  # the second stage's errors, from frame _base on
+        self._pts = np.zeros((256, len(self.whole.point_masses_kg), 3))  # the first stage's link points, too
         self._offset = tuple(self.standing_offset)
         self._previous_offset = None
+        self._point_shares = self._shares_of_points()
         self._primed = True
+
+    def _shares_of_points(self) -> np.ndarray:
+        """(13, 2): how far each link point (torso, legs) moves in x and in y per metre the whole CoM moves,
+        the feet standing (the walking crouch, measured once: ~1.25 for the torso, 0 for the feet)."""
+        ankles = np.repeat(self._arrays["ankles"][:1], 3, 0)
+        root = np.repeat([[*(self._arrays["zmp"][0] + self.standing_offset), self.planner.walk_root_z]], 3, 0)
+        root[1, 0] += SLOPE_PROBE_M
+        root[2, 1] += SLOPE_PROBE_M
+        points = self.whole.link_points(root, self.whole.legs(root, ankles))
+        com = self.whole.com(root, ankles)
+        return np.column_stack([(points[1, :, 0] - points[0, :, 0]) / (com[1, 0] - com[0, 0]),
+                                (points[2, :, 1] - points[0, :, 1]) / (com[2, 1] - com[0, 1])])
 
     def _stage1_until(self, j: int) -> None:
         """Run the first preview stage and place the body up to frame j (clamped to the last frame)."""
@@ -387,7 +403,16 @@ class BalancedWalker:
                                       MAX_PLACEMENT_ITERATIONS, yaws)
         self._s1_offset = (root[0] - com[0], root[1] - com[1])
         self._s1_offsets[i] = self._s1_offset
-        self._s1_points[i] = self._flat.world_points(root, q, yaws)
+        self._reserve(i)
+        self._pts[i - self._base] = self._flat.world_points(root, q, yaws)
+
+    def _reserve(self, j: int) -> None:
+        """Room in the per-frame stores (errors, points) up to frame j + 1."""
+        need = j - self._base + 2
+        if len(self._err) < need:
+            more = max(len(self._err), need - len(self._err))
+            self._err = np.concatenate([self._err, np.zeros((more, 2))])
+            self._pts = np.concatenate([self._pts, np.zeros((more,) + self._pts.shape[1:])])
 
     def _replan_lookahead(self, spread: bool = False) -> None:
         """A step appended while walking: rerun the first stage from the next output frame with the new
@@ -399,19 +424,27 @@ class BalancedWalker:
             return
         self._stage1.restore(self._s1_snapshot[k])
         end = min(self._s1_next - 1, self._last_frame())
+        frames = range(k, end + 1)
+        before = np.array([self._s1_com[i] for i in frames])
         self._run_stage1(k, end)
         self._pending = (k, end)
         if not spread:
             self.work(end - k + 1)
+            return
+        # Until work() re-places them, the frames' link points move with their CoM's change as the standing
+        # pose's do (_point_shares): the second stage sees the new plan's CoM with the old plan's legs.
+        moved = np.array([self._s1_com[i] for i in frames]) - before
+        self._pts[k - self._base:end - self._base + 1, :, :2] += moved[:, None, :] * self._point_shares
+        self._refresh_errors(k, end)
 
     def work(self, frames: int | None = None) -> int:
         """Redo up to ``frames`` (default SPREAD_FRAMES) of the body placements a spread append left
         pending, nearest first; returns how many are still pending. Call it once a frame, before
         ``next_frame``: a step appended with ``spread=True`` reruns the first preview stage's recursion at
         once (cheap) but re-places the body for the new CoM of each frame of the horizon only here; until
-        then a frame far ahead keeps its previous placement, which only feeds the second stage's multibody
-        ZMP error (the error of a slightly older plan, for a few frames). The frames handed out are
-        always placed for the new CoM (they are placed again when handed out)."""
+        then a frame ahead keeps its previous placement shifted by its CoM's change, which only feeds the
+        second stage's multibody ZMP error (the old plan's leg motion on the new plan's CoM, for a few
+        frames). The frames handed out are always placed for the new CoM (placed when handed out)."""
         if self._pending is None:
             return 0
         first, end = self._pending
@@ -439,8 +472,8 @@ class BalancedWalker:
             root, q, _ = self.whole.place(coms, self._ext["ankles"][idx], self._ext["root_z"][idx], guess,
                                           self.com_slope, yaw)
             points = self.whole.link_points(root, q, yaw)
+            self._pts[first - self._base:last - self._base + 1] = points
             for n, i in enumerate(frames):
-                self._s1_points[i] = points[n]
                 self._s1_offsets[i] = tuple(root[n, :2] - coms[n])
         else:
             for i in range(first, last + 1):
@@ -461,17 +494,14 @@ class BalancedWalker:
         """Multibody (point-mass) ZMP minus the reference at frames first..last (at most the last frame), at
         once: the points of frames first - 1..last + 1 (the walk's ends repeated, as the offline padding)."""
         end = self._last_frame()
-        window = np.array([self._points(i) for i in range(max(first - 1, 0), min(last + 1, end) + 1)])
+        b = self._base
+        window = self._pts[max(first - 1, 0) - b:min(last + 1, end) - b + 1]
         if first == 0:
             window = np.concatenate([window[:1], window])
         if last == end:
             window = np.concatenate([window, window[-1:]])
         zmp = multibody_zmp(window, self.whole.point_masses_kg, 1.0 / self.rate_hz)
-        b = self._base
         self._err[first - b:last - b + 1] = zmp - self._ext["zmp"][first - b:last - b + 1]
-
-    def _points(self, j: int):
-        return self._s1_points[max(0, min(j, self._last_frame()))]
 
     def _zmp_errors_until(self, j: int) -> None:
         """Multibody ZMP errors for the frames up to j not computed yet (frames past the end: the last
@@ -479,10 +509,7 @@ class BalancedWalker:
         if self._err_next > j:
             return
         b = self._base
-        if len(self._err) <= j - b:
-            grown = np.zeros((max(2 * len(self._err), j - b + 1), 2))
-            grown[:self._err_next - b] = self._err[:self._err_next - b]
-            self._err = grown
+        self._reserve(j)
         last = self._last_frame()
         if self._err_next <= min(j, last):
             self._errors(self._err_next, min(j, last))
@@ -549,7 +576,7 @@ class BalancedWalker:
                                 yaws)
         self._previous_offset = self._offset
         self._offset = (root[0] - com[0], root[1] - com[1])
-        for cache in (self._s1_com, self._s1_points, self._s1_snapshot, self._s1_offsets):  # drop the past
+        for cache in (self._s1_com, self._s1_snapshot, self._s1_offsets):  # drop the past
             cache.pop(k - 2, None)
         goal = q
         if self.feedforward:
