@@ -56,6 +56,8 @@ STORED_FRAMES = 1200
 """The online walker keeps its plan's per-frame arrays from KEPT_FRAMES behind the output frame on, and drops
 the older ones whenever that reaches this many frames: a drive of any length holds bounded memory."""
 KEPT_FRAMES = 32
+RESERVE_FRAMES = 256
+"""The second stage's per-frame stores grow by this many frames at a time."""
 FEEDFORWARD_SMOOTHING_S = 0.1
 """The sag feedforward splits the weight between the feet by the planned load share averaged over +- this:
 a short double support (2 frames at 0.2 m/s) would otherwise swing the stance joints' offsets across in
@@ -320,6 +322,15 @@ class BalancedWalker:
     def plan_start_frame(self) -> int:
         return self._base
 
+    @property
+    def stored_frames(self) -> int:
+        """The most frames any of the walker's per-frame stores holds (the plan's arrays, the preview
+        stages' errors, points and snapshots): bounded on a walk of any length."""
+        stores = [len(self._ext["zmp"]), len(self._zmp_padded)]
+        if self._primed:
+            stores += [len(self._err), len(self._pts), len(self._s1_com), len(self._s1_snapshot)]
+        return max(stores)
+
     def _ext_at(self, name: str, j: int):
         a = self._ext[name]
         return a[min(j - self._base, len(a) - 1)]
@@ -410,7 +421,7 @@ class BalancedWalker:
         """Room in the per-frame stores (errors, points) up to frame j + 1."""
         need = j - self._base + 2
         if len(self._err) < need:
-            more = max(len(self._err), need - len(self._err))
+            more = max(RESERVE_FRAMES, need - len(self._err))
             self._err = np.concatenate([self._err, np.zeros((more, 2))])
             self._pts = np.concatenate([self._pts, np.zeros((more,) + self._pts.shape[1:])])
 
