@@ -5,9 +5,13 @@ planner plans the next step from the current command (gaitbot.gait.steer.planner
 (rerunning its first preview stage over the look-ahead); then ``next_frame``. The command changes every
 few seconds (a turn, a sidestep, an arc, forward). Prints the per-frame time (p50, p99, max, ms, wall
 clock on this machine, one thread) with and without the frames that appended a step, and a step's
-planning time.
+planning time. With ``--spread`` the walker spreads each append's replan over the frames after it
+(``append_footstep(..., spread=True)`` and ``work()`` every other frame, as ``gaitbot drive`` does).
 
-    python tools/bench_steer.py [--robot op3] [--seconds 30]
+    python tools/bench_steer.py [--robot op3] [--seconds 30] [--spread] [--cpu]
+
+``--cpu``: the process's CPU time (time.process_time) instead of the wall clock, whose tail on a shared
+machine is the scheduler's.
 """
 
 from __future__ import annotations
@@ -33,7 +37,10 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--robot", default="op3")
     p.add_argument("--seconds", type=float, default=30.0)
+    p.add_argument("--spread", action="store_true", help="spread each replan over the next frames (gaitbot drive)")
+    p.add_argument("--cpu", action="store_true", help="CPU time (time.process_time) instead of the wall clock")
     args = p.parse_args(argv)
+    clock = time.process_time if args.cpu else time.perf_counter
     config = load_robot(args.robot)
     gait = balanced_gait_settings(config)
     walker = balanced_walker(config, gait)
@@ -42,25 +49,29 @@ def main(argv=None) -> int:
     frames, plan_times, appended = [], [], []
     k = 0
     while k < args.seconds * rate:
-        t0 = time.perf_counter()
+        t0 = clock()
         queued_s = walker.planned_frames / rate - k / rate
         added = False
         if queued_s < LOOKAHEAD_S:
             command = VelocityCommand(*COMMANDS[int(k / rate / 6.0) % len(COMMANDS)])
-            p0 = time.perf_counter()
+            p0 = clock()
             step = planner.next_step(command, walker.next_swing_side)
-            plan_times.append(time.perf_counter() - p0)
-            walker.append_footstep(step.foothold, step.length_m)
+            plan_times.append(clock() - p0)
+            walker.append_footstep(step.foothold, step.length_m, spread=args.spread)
             added = True
+        elif args.spread:
+            walker.work()
         frame = walker.next_frame()
-        frames.append(time.perf_counter() - t0)
+        frames.append(clock() - t0)
         appended.append(added)
         k += 1
         if frame is None:
             break
     f = 1e3 * np.array(frames)
     a = np.array(appended)
-    print(f"{args.robot}: {len(f)} frames ({len(f) / rate:.0f} s), {a.sum()} steps appended while walking")
+    how = "each replan spread over the frames after it" if args.spread else "each replan at once"
+    print(f"{args.robot}: {len(f)} frames ({len(f) / rate:.0f} s), {a.sum()} steps appended while walking ({how}; "
+          f"{'CPU' if args.cpu else 'wall'} time)")
     for label, x in (("every frame", f), ("frames without an append", f[~a]), ("frames that appended a step", f[a])):
         print(f"  {label}: p50 {np.percentile(x, 50):.2f} ms, p99 {np.percentile(x, 99):.2f} ms, max {x.max():.2f} ms")
     q = 1e3 * np.array(plan_times)
