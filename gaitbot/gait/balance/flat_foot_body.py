@@ -66,30 +66,26 @@ class FlatFootBody:
         s = SIDE_SIGN[side]
         hx, hy, hz = self.hips[side]
         cr, sr = math.cos(s * q[1]), math.sin(s * q[1])
-        out = []
         # Rx(s roll), then pitch about y: thigh -p, shank -p+k, ankle -p+k-a; the foot adds Rx(s ankle_roll)
-        pitches = (0.0, 0.0, -q[2], -q[2] + q[3], -q[2] + q[3] - q[4], -q[2] + q[3] - q[4])
-        ox, oy, oz = hx, hy, hz
-        knee = (ox, oy, oz)
-        for i, ((cx, cy, cz), b) in enumerate(zip(self.link_com[side], pitches)):
-            if i == 3:  # the knee: thigh_m down the thigh
-                cb, sb = math.cos(pitches[2]), math.sin(pitches[2])
-                ox, oy, oz = hx - self.l1 * sb, hy + self.l1 * sr * cb, hz - self.l1 * cr * cb
-                knee = (ox, oy, oz)
-            elif i == 4:  # the ankle: shank_m down the shank
-                cb, sb = math.cos(pitches[3]), math.sin(pitches[3])
-                ox, oy, oz = ox - self.l2 * sb, oy + self.l2 * sr * cb, oz - self.l2 * cr * cb
-            if i == 0:
-                vx, vy, vz = cx, cy, cz
-            else:
-                if i == 5:
-                    ca, sa = math.cos(s * q[5]), math.sin(s * q[5])
-                    cy, cz = ca * cy - sa * cz, sa * cy + ca * cz
-                cb, sb = math.cos(b), math.sin(b)
-                px, pz = cb * cx + sb * cz, -sb * cx + cb * cz
-                vx, vy, vz = px, cr * cy - sr * pz, sr * cy + cr * pz
-            out.append((ox + vx, oy + vy, oz + vz))
-        return out, knee, (ox, oy, oz)
+        p2 = -q[2]
+        p3 = p2 + q[3]
+        p4 = p3 - q[4]
+        c2, s2, c3, s3, c4, s4 = math.cos(p2), math.sin(p2), math.cos(p3), math.sin(p3), math.cos(p4), math.sin(p4)
+        (x0, y0, z0), (x1, y1, z1), (x2, y2, z2), (x3, y3, z3), (x4, y4, z4), (x5, y5, z5) = self.link_com[side]
+        l1, l2 = self.l1, self.l2
+        kx, ky, kz = hx - l1 * s2, hy + l1 * sr * c2, hz - l1 * cr * c2
+        ax, ay, az = kx - l2 * s3, ky + l2 * sr * c3, kz - l2 * cr * c3
+        ca, sa = math.cos(s * q[5]), math.sin(s * q[5])
+        y5, z5 = ca * y5 - sa * z5, sa * y5 + ca * z5
+        out = [(hx + x0, hy + y0, hz + z0),
+               (hx + x1, hy + cr * y1 - sr * z1, hz + sr * y1 + cr * z1)]
+        for (ox, oy, oz), (cb, sb), (cx, cy, cz) in (((hx, hy, hz), (c2, s2), (x2, y2, z2)),
+                                                      ((kx, ky, kz), (c3, s3), (x3, y3, z3)),
+                                                      ((ax, ay, az), (c4, s4), (x4, y4, z4)),
+                                                      ((ax, ay, az), (c4, s4), (x5, y5, z5))):
+            pz = -sb * cx + cb * cz
+            out.append((ox + cb * cx + sb * cz, oy + cr * cy - sr * pz, oz + sr * cy + cr * pz))
+        return out, (kx, ky, kz), (ax, ay, az)
 
     def gravity_torques(self, q, share_left: float, cops) -> list[float]:
         """As MassModel.gravity_torques for one frame: the 12 joint torques (N m) holding the pose;
