@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-import gaitbot.gait.balance.walker as walker_module
+import gaitbot.gait.balance.lookahead as lookahead
 from gaitbot.app.options import load_robot
 from gaitbot.gait.steer.command import VelocityCommand
 from gaitbot.robot.balanced_walk import balanced_gait_settings, balanced_walker
@@ -56,7 +56,7 @@ def test_a_spread_replan_walks_the_frames_of_one_done_at_once():
 
 def test_dropping_the_plan_behind_the_output_changes_no_frame(monkeypatch):
     _, kept = steered_walk(True, 12, per_command=3)
-    monkeypatch.setattr(walker_module, "STORED_FRAMES", 60)
+    monkeypatch.setattr(lookahead, "STORED_FRAMES", 60)
     walker, trimmed = steered_walk(True, 12, per_command=3)
     assert walker.plan_start_frame > 300  # it did drop
     assert walker.stored_frames < 60 + 3 * walker.gains.horizon_frames
@@ -85,7 +85,7 @@ def test_twenty_minutes_of_walking_hold_bounded_memory():
         assert walker.next_frame() is not None
         if j % 600 == 0:
             sizes.append(walker.stored_frames)
-    bound = walker_module.STORED_FRAMES + walker_module.RESERVE_FRAMES + 3 * walker.gains.horizon_frames
+    bound = lookahead.STORED_FRAMES + lookahead.RESERVE_FRAMES + 3 * walker.gains.horizon_frames
     assert max(sizes) <= bound
-    assert walker.plan_start_frame > frames - walker_module.STORED_FRAMES - walker.rise_frames
+    assert walker.plan_start_frame > frames - lookahead.STORED_FRAMES - walker.rise_frames
 
