@@ -100,12 +100,13 @@ def main() -> None:
     parser.add_argument("--latency", action="store_true", help="print only the latency (the same on any machine)")
     parser.add_argument("--markdown", action="store_true", help="print the latency as the docs' figure block")
     args = parser.parse_args()
+    load_before = os.getloadavg()
     rows = [measure(robot, args.minutes, args.seed) for robot in args.robot or ["op3", "bioloid"]]
     if args.latency or args.markdown:
         table = latency_table(rows)
         print(f"<!-- figure drive-latency -->\n{table}\n<!-- /figure -->" if args.markdown else table)
         return
-    print(f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())} (1, 5, 15 min) before the run")
+    print(f"load average {' '.join(f'{v:.2f}' for v in load_before)} (1, 5, 15 min) before the run")
     print("| robot | frames | frame work p50 ms | p99 ms | max ms | next_frame p50 ms | p99 ms | command to its step, "
           "median s | max s |")
     print("|---|---|---|---|---|---|---|---|---|")
