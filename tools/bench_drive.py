@@ -2,9 +2,12 @@
 check, the ticks), the walker's next_frame alone, and the time from a command to the step that carries it.
 
     python tools/bench_drive.py --robot op3 --minutes 2 --seed 1
+    python tools/bench_drive.py --latency --markdown    # the latency alone, as docs/benchmarks.md's figure
 
 Random commands (seeded, changing every 2-5 s, anywhere within the robot's [steer] limits, stops included)
-are played on the drive's own clock; CPU time per call (time.process_time), one thread.
+are played on the drive's own clock; CPU time per call (time.process_time), one thread. The load average
+is printed beside the figures (the machine's other work inflates the tail). The latency (from a new command
+to the start of the first step planned from it) is on the drive's own clock: the same on any machine.
 """
 
 from __future__ import annotations
@@ -75,8 +78,18 @@ def measure(robot: str, minutes: float, seed: int) -> dict:
     ms = 1e3
     f, w, lat = np.array(frame_s) * ms, np.array(walker_s) * ms, np.array(frames.log.latencies_s)
     return {"robot": robot, "frames": len(f), "frame_p50_ms": np.percentile(f, 50), "frame_p99_ms": np.percentile(f, 99),
-            "frame_max_ms": f.max(), "next_frame_p99_ms": np.percentile(w, 99), "latency_median_s": np.median(lat),
-            "latency_max_s": lat.max(), "steps": frames.log.steps}
+            "frame_max_ms": f.max(), "next_frame_p50_ms": np.percentile(w, 50),
+            "next_frame_p99_ms": np.percentile(w, 99), "latency_median_s": np.median(lat),
+            "latency_p90_s": np.percentile(lat, 90), "latency_max_s": lat.max(), "latencies": len(lat),
+            "steps": frames.log.steps, "step_s": footstep_planner(config).step_s}
+
+
+def latency_table(rows: list[dict]) -> str:
+    lines = ["| robot | commands changed while walking | step s | command to its step, median s | p90 s | max s |",
+             "|---|---|---|---|---|---|"]
+    lines += [f"| {r['robot']} | {r['latencies']} | {r['step_s']:.3f} | {r['latency_median_s']:.2f} | "
+              f"{r['latency_p90_s']:.2f} | {r['latency_max_s']:.2f} |" for r in rows]
+    return "\n".join(lines)
 
 
 def main() -> None:
@@ -84,15 +97,24 @@ def main() -> None:
     parser.add_argument("--robot", action="append", help="robot config (repeatable; default op3 and bioloid)")
     parser.add_argument("--minutes", type=float, default=2.0)
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--latency", action="store_true", help="print only the latency (the same on any machine)")
+    parser.add_argument("--markdown", action="store_true", help="print the latency as the docs' figure block")
     args = parser.parse_args()
-    print("| robot | frames | frame work p50 ms | p99 ms | max ms | next_frame p99 ms | command to its step, "
+    load_before = os.getloadavg()
+    rows = [measure(robot, args.minutes, args.seed) for robot in args.robot or ["op3", "bioloid"]]
+    if args.latency or args.markdown:
+        table = latency_table(rows)
+        print(f"<!-- figure drive-latency -->\n{table}\n<!-- /figure -->" if args.markdown else table)
+        return
+    print(f"load average {' '.join(f'{v:.2f}' for v in load_before)} (1, 5, 15 min) before the run")
+    print("| robot | frames | frame work p50 ms | p99 ms | max ms | next_frame p50 ms | p99 ms | command to its step, "
           "median s | max s |")
-    print("|---|---|---|---|---|---|---|---|")
-    for robot in args.robot or ["op3", "bioloid"]:
-        r = measure(robot, args.minutes, args.seed)
+    print("|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
         print(f"| {r['robot']} | {r['frames']} | {r['frame_p50_ms']:.3f} | {r['frame_p99_ms']:.3f} | "
-              f"{r['frame_max_ms']:.2f} | {r['next_frame_p99_ms']:.3f} | {r['latency_median_s']:.2f} | "
-              f"{r['latency_max_s']:.2f} |")
+              f"{r['frame_max_ms']:.2f} | {r['next_frame_p50_ms']:.3f} | {r['next_frame_p99_ms']:.3f} | "
+              f"{r['latency_median_s']:.2f} | {r['latency_max_s']:.2f} |")
+    print(f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())} after the run")
 
 
 if __name__ == "__main__":

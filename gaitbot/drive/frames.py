@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gaitbot.drive.guard import FrameGuard
-from gaitbot.drive.spread import SpreadReplan
 from gaitbot.gait.joints import LEG_JOINTS
 from gaitbot.gait.steer.command import STILL, TimedCommand, VelocityCommand
 from gaitbot.gait.steer.planner import frame_of, leading_side
@@ -113,7 +112,6 @@ class DriveFrames:
     def _new_walker(self) -> None:
         """A walker standing where the drive stands (its own world; the odometry composes it)."""
         self._walker = balanced_walker(self.config, self.gait)
-        self._spread = SpreadReplan(self._walker)
         self._next_step = None
         self._planner = footstep_planner(self.config, self.gait)
         self._origin = frame_of(self._walker.feet)
@@ -134,8 +132,8 @@ class DriveFrames:
             walker.lead_with(leading_side(self.command))
             self._started = True
             self._walker_k0 = self.k
-        self._plan_ahead()
-        self._spread.work()
+        if not self._plan_ahead():  # a frame that appends a step leaves the replan's share for the next
+            walker.work()  # a share of the last append's replan (BalancedWalker.work)
         frame = walker.next_frame()
         if frame is None:  # the walker has closed its feet and lowered to standing
             self._close_walker()
@@ -179,29 +177,32 @@ class DriveFrames:
         if self.on_command is not None:
             self.on_command(timed)
 
-    def _plan_ahead(self) -> None:
+    def _plan_ahead(self) -> bool:
         """At most one step a frame, while fewer than queue_steps planned steps have not started; a step is
-        planned and checked in one frame and handed to the walker in the next (spreading the work)."""
+        planned and checked in one frame and handed to the walker in the next (spreading the work).
+        Returns whether a step was handed to the walker."""
         walker, planner = self._walker, self._planner
         if self._next_step is not None:
             step, self._next_step = self._next_step, None
             if not (walker.finished or self.ending):
                 self._append(step)
-            return
+                return True
+            return False
         if walker.finished or self.ending:
-            return
+            return False
         if self.command.is_still and planner.standing():
-            return
+            return False
         now_s = walker._out / walker.rate_hz
         pending = sum(1 for s in walker.planned_steps[-self.queue_steps - 1:] if s.start_s >= now_s)
         if pending >= self.queue_steps:
-            return
+            return False
         side = walker.next_swing_side
         step = self._checked_step(side, self.command)
         if step is None:  # even slowing down would not keep the soles apart: no more steps
             self.ending = True
-            return
+            return False
         self._next_step = step
+        return False
 
     def _checked_step(self, side: str, command: VelocityCommand):
         """The planner's next step, its soles' swept gap checked again; a step that fails is replaced by a
@@ -225,7 +226,7 @@ class DriveFrames:
 
     def _append(self, step) -> None:
         walker = self._walker
-        walker.append_footstep(step.foothold, max(0.0, step.length_m))
+        walker.append_footstep(step.foothold, max(0.0, step.length_m), spread=True)
         if self._changed_s is not None:  # the first step planned since the command changed
             start_s = self._walker_k0 * self.period_s + walker.planned_steps[-1].start_s
             self.log.latencies_s.append(start_s - self._changed_s)

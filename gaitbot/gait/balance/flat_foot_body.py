@@ -33,6 +33,7 @@ class FlatFootBody:
         self.link_kg = [body.leg_links[n].mass_kg for n in LEG_LINKS]
         self.link_com = {s: [tuple(float(v) for v in body.leg_link(n, s).com_m) for n in LEG_LINKS] for s in SIDES}
         self.total_kg = self.torso_kg + 2 * sum(self.link_kg)
+        self._last_q, self._last_points = None, []
 
     def leg_ik(self, side: str, rx: float, ry: float, rz: float, gamma: float = 0.0) -> list[float]:
         """One leg's six angles for r = hip - ankle (root frame); the foot flat, turned by gamma (rad)
@@ -65,34 +66,31 @@ class FlatFootBody:
         s = SIDE_SIGN[side]
         hx, hy, hz = self.hips[side]
         cr, sr = math.cos(s * q[1]), math.sin(s * q[1])
-        out = []
         # Rx(s roll), then pitch about y: thigh -p, shank -p+k, ankle -p+k-a; the foot adds Rx(s ankle_roll)
-        pitches = (0.0, 0.0, -q[2], -q[2] + q[3], -q[2] + q[3] - q[4], -q[2] + q[3] - q[4])
-        ox, oy, oz = hx, hy, hz
-        knee = (ox, oy, oz)
-        for i, ((cx, cy, cz), b) in enumerate(zip(self.link_com[side], pitches)):
-            if i == 3:  # the knee: thigh_m down the thigh
-                cb, sb = math.cos(pitches[2]), math.sin(pitches[2])
-                ox, oy, oz = hx - self.l1 * sb, hy + self.l1 * sr * cb, hz - self.l1 * cr * cb
-                knee = (ox, oy, oz)
-            elif i == 4:  # the ankle: shank_m down the shank
-                cb, sb = math.cos(pitches[3]), math.sin(pitches[3])
-                ox, oy, oz = ox - self.l2 * sb, oy + self.l2 * sr * cb, oz - self.l2 * cr * cb
-            if i == 0:
-                vx, vy, vz = cx, cy, cz
-            else:
-                if i == 5:
-                    ca, sa = math.cos(s * q[5]), math.sin(s * q[5])
-                    cy, cz = ca * cy - sa * cz, sa * cy + ca * cz
-                cb, sb = math.cos(b), math.sin(b)
-                px, pz = cb * cx + sb * cz, -sb * cx + cb * cz
-                vx, vy, vz = px, cr * cy - sr * pz, sr * cy + cr * pz
-            out.append((ox + vx, oy + vy, oz + vz))
-        return out, knee, (ox, oy, oz)
+        p2 = -q[2]
+        p3 = p2 + q[3]
+        p4 = p3 - q[4]
+        c2, s2, c3, s3, c4, s4 = math.cos(p2), math.sin(p2), math.cos(p3), math.sin(p3), math.cos(p4), math.sin(p4)
+        (x0, y0, z0), (x1, y1, z1), (x2, y2, z2), (x3, y3, z3), (x4, y4, z4), (x5, y5, z5) = self.link_com[side]
+        l1, l2 = self.l1, self.l2
+        kx, ky, kz = hx - l1 * s2, hy + l1 * sr * c2, hz - l1 * cr * c2
+        ax, ay, az = kx - l2 * s3, ky + l2 * sr * c3, kz - l2 * cr * c3
+        ca, sa = math.cos(s * q[5]), math.sin(s * q[5])
+        y5, z5 = ca * y5 - sa * z5, sa * y5 + ca * z5
+        out = [(hx + x0, hy + y0, hz + z0),
+               (hx + x1, hy + cr * y1 - sr * z1, hz + sr * y1 + cr * z1)]
+        for (ox, oy, oz), (cb, sb), (cx, cy, cz) in (((hx, hy, hz), (c2, s2), (x2, y2, z2)),
+                                                      ((kx, ky, kz), (c3, s3), (x3, y3, z3)),
+                                                      ((ax, ay, az), (c4, s4), (x4, y4, z4)),
+                                                      ((ax, ay, az), (c4, s4), (x5, y5, z5))):
+            pz = -sb * cx + cb * cz
+            out.append((ox + cb * cx + sb * cz, oy + cr * cy - sr * pz, oz + sr * cy + cr * pz))
+        return out, (kx, ky, kz), (ax, ay, az)
 
     def gravity_torques(self, q, share_left: float, cops) -> list[float]:
         """As MassModel.gravity_torques for one frame: the 12 joint torques (N m) holding the pose;
-        cops[side index] = (x, y) of each foot's centre of pressure in the root frame."""
+        cops[side index] = (x, y) of each foot's centre of pressure in the root frame; a turned foot (hip yaw
+        q[0] or q[6] not 0) turns its leg's links and joint axes about the hip."""
         g = GRAVITY_M_S2
         weight = self.total_kg * g
         out = []
@@ -104,6 +102,14 @@ class FlatFootBody:
             cr, sr = math.cos(s * leg[1]), math.sin(s * leg[1])
             b5 = -leg[2] + leg[3] - leg[4]
             axes = ((0.0, 0.0), (s, 0.0), (0.0, -cr), (0.0, cr), (0.0, -cr), (s * math.cos(b5), s * sr * math.sin(b5)))
+            if leg[0] != 0.0:  # the hip yaw joint turns the rest of the leg (points and axes) about the hip
+                cg, sg = math.cos(s * leg[0]), math.sin(s * leg[0])
+                hx, hy, _ = self.hips[side]
+                points = [(hx + cg * (px - hx) - sg * (py - hy), hy + sg * (px - hx) + cg * (py - hy), pz)
+                          for px, py, pz in points]
+                knee, ankle = ((hx + cg * (px - hx) - sg * (py - hy), hy + sg * (px - hx) + cg * (py - hy), pz)
+                               for px, py, pz in (knee, ankle))
+                axes = tuple((cg * ax - sg * ay, sg * ax + cg * ay) for ax, ay in axes)
             joints = (self.hips[side], self.hips[side], self.hips[side], knee, ankle, ankle)
             fx, fy = cops[i]
             for j in range(6):
@@ -139,9 +145,12 @@ class FlatFootBody:
 
     def world_points(self, root, q, yaws=None) -> list[tuple[float, float, float]]:
         """The torso's and the 12 leg links' CoMs in the world (the torso turned by the feet's mean yaw)."""
-        local = [self.torso_com]
-        for k, side in enumerate(SIDES):
-            local += self.link_points(side, q[6 * k:6 * k + 6])
+        if self._last_q is q:  # the placement's last pose (com_in_root has the points)
+            local = [self.torso_com] + self._last_points
+        else:
+            local = [self.torso_com]
+            for k, side in enumerate(SIDES):
+                local += self.link_points(side, q[6 * k:6 * k + 6])
         psi = 0.0 if yaws is None else 0.5 * (yaws[0] + yaws[1])
         if psi == 0.0:
             return [(root[0] + p[0], root[1] + p[1], root[2] + p[2]) for p in local]
@@ -151,11 +160,12 @@ class FlatFootBody:
     def com_in_root(self, q) -> tuple[float, float, float]:
         m = self.torso_kg
         x, y, z = (m * c for c in self.torso_com)
-        for i, side in enumerate(SIDES):
-            for kg, (px, py, pz) in zip(self.link_kg, self.link_points(side, q[6 * i:6 * i + 6])):
-                x += kg * px
-                y += kg * py
-                z += kg * pz
+        points = self.link_points("left", q[0:6]) + self.link_points("right", q[6:12])
+        for kg, (px, py, pz) in zip(self.link_kg + self.link_kg, points):
+            x += kg * px
+            y += kg * py
+            z += kg * pz
+        self._last_q, self._last_points = q, points  # world_points of the same pose reuses them
         return x / self.total_kg, y / self.total_kg, z / self.total_kg
 
     def place(self, com_x: float, com_y: float, ankles, root_z: float, guess_dx: float, guess_dy: float,

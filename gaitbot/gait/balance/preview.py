@@ -142,3 +142,53 @@ def preview_offline(gains: PreviewGains, reference, com_xy0=None) -> np.ndarray:
         out[:, axis] = (lfilter(num_p[0], den_p, preview[:, axis]) + lfilter(num_r[0], den_r, ref[:, axis])
                         + x0[axis] * unit)
     return out
+
+
+class FloatPreview:
+    """PreviewController's recursion in plain floats, the preview sum given (the online walker's hot path:
+    numpy costs microseconds a call whatever the array size, and the state is 2 x 3 numbers).
+
+    ``step(rx, ry, px, py)``: the reference now (rx, ry) and its preview sum sum_j f_j r_{k+j} (px, py)
+    (``preview_sums``); ``snapshot()`` / ``restore()``: the state as a tuple."""
+
+    def __init__(self, gains: PreviewGains, com_xy_m) -> None:
+        a, self.b, self.c = gains.a, tuple(float(v) for v in gains.b), tuple(float(v) for v in gains.c)
+        if not (a[1, 0] == a[2, 0] == a[2, 1] == 0.0 and a[0, 0] == a[1, 1] == a[2, 2] == 1.0):
+            raise ValueError("FloatPreview expects the cart-table's triple integrator")
+        self.a01, self.a02, self.a12 = float(a[0, 1]), float(a[0, 2]), float(a[1, 2])
+        self.k_sum, self.k = gains.k_sum, tuple(float(v) for v in gains.k_state)
+        self.f = gains.f
+        self.state = (float(com_xy_m[0]), 0.0, 0.0, float(com_xy_m[1]), 0.0, 0.0, 0.0, 0.0)
+
+    def snapshot(self) -> tuple:
+        return self.state
+
+    def restore(self, state: tuple) -> None:
+        self.state = state
+
+    @property
+    def com(self) -> tuple[float, float]:
+        """The CoM position (x, y) at the current frame (before its step)."""
+        return self.state[0], self.state[3]
+
+    def preview_sums(self, padded, start: int, count: int) -> np.ndarray:
+        """sum_j f_j r_{i+j}, j = 1..N, for i = start..start + count - 1 (count, 2) of a reference padded past
+        its end."""
+        n = len(self.f)
+        if count == 1:
+            return (self.f @ padded[start + 1:start + 1 + n])[None]
+        part = padded[start + 1:start + count + n]
+        return np.column_stack([np.correlate(part[:, 0], self.f), np.correlate(part[:, 1], self.f)])
+
+    def step(self, rx: float, ry: float, px: float, py: float) -> None:
+        x0, x1, x2, y0, y1, y2, ex, ey = self.state
+        b0, b1, b2 = self.b
+        c0, c1, c2 = self.c
+        k0, k1, k2 = self.k
+        ks, a01, a02, a12 = self.k_sum, self.a01, self.a02, self.a12
+        ex += c0 * x0 + c1 * x1 + c2 * x2 - rx
+        ey += c0 * y0 + c1 * y1 + c2 * y2 - ry
+        ux = -ks * ex - (k0 * x0 + k1 * x1 + k2 * x2) + px
+        uy = -ks * ey - (k0 * y0 + k1 * y1 + k2 * y2) + py
+        self.state = (x0 + a01 * x1 + a02 * x2 + b0 * ux, x1 + a12 * x2 + b1 * ux, x2 + b2 * ux,
+                      y0 + a01 * y1 + a02 * y2 + b0 * uy, y1 + a12 * y2 + b1 * uy, y2 + b2 * uy, ex, ey)

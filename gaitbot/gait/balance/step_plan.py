@@ -66,6 +66,9 @@ def swing_yaw_share(position_share):
     """The share of its turn the swing foot has made when its ankle point is ``position_share`` of the way
     to its foothold (0 -> 1 over YAW_WINDOW)."""
     a, b = YAW_WINDOW
+    if isinstance(position_share, float):  # one share (the sole sweep's hot path): the same arithmetic in floats
+        u = min(max((position_share - a) / (b - a), 0.0), 1.0)
+        return u * u * u * (u * (6 * u - 15) + 10)
     return smootherstep((np.asarray(position_share, dtype=float) - a) / (b - a))
 
 
@@ -101,6 +104,7 @@ class PlanBlocks:
     cops: list = field(default_factory=list)
     swinging: list = field(default_factory=list)
     yaw: list = field(default_factory=list)
+    taken: int = 0  # frames already handed out by take()
 
     def add(self, zmp, ankles, root_z, share_left, cops, swinging, yaw=(0.0, 0.0)) -> None:
         """One block of n frames; yaw: each foot's yaw (rad), (2,) held or (n, 2)."""
@@ -115,10 +119,19 @@ class PlanBlocks:
 
     @property
     def frames(self) -> int:
-        return int(sum(len(z) for z in self.zmp))
+        """Frames planned so far (those taken included): the next block's first frame number."""
+        return self.taken + int(sum(len(z) for z in self.zmp))
 
     def arrays(self, start_block: int = 0) -> dict:
         return {name: np.concatenate(getattr(self, name)[start_block:]) for name in PLAN_KEYS}
+
+    def take(self) -> dict:
+        """The blocks added since the last take as arrays, dropped from here (frame numbers go on)."""
+        out = self.arrays()
+        self.taken += len(out["zmp"])
+        for name in PLAN_KEYS:
+            getattr(self, name).clear()
+        return out
 
 
 @dataclass(frozen=True)

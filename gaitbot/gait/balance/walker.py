@@ -19,7 +19,9 @@ multibody ZMP error over its horizon), placing the body with flat_foot_body.py's
 ``generate_balanced_walk`` runs the same recursions over a closed walk, vectorised. Steps appended while
 walking enter the horizon at once: until the walk is closed, the frames beyond the queued steps are the
 close-and-stand that ``finish`` would add (so a walker whose queue runs dry stops safely), and
-appending a step reruns the first stage from the next output frame with the new reference.
+appending a step reruns the first stage from the next output frame with the new reference: its body
+placements at once, or with ``spread=True`` a few a frame in ``work`` (gaitbot.gait.balance.lookahead,
+which also drops the plan behind the output: bounded memory on a walk of any length).
 """
 
 from __future__ import annotations
@@ -29,10 +31,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gaitbot.gait.balance.flat_foot_body import FlatFootBody
-from gaitbot.gait.balance.placement import (MAX_PLACEMENT_ITERATIONS, PLACEMENT_TOLERANCE_M, WholeBody,
-                                            multibody_zmp, to_world, torso_yaw)
-from gaitbot.gait.balance.preview import PreviewController, preview_gains, preview_offline
+from gaitbot.gait.balance.lookahead import Lookahead, extrapolated
+from gaitbot.gait.balance.placement import (MAX_PLACEMENT_ITERATIONS, PLACEMENT_TOLERANCE_M, WholeBody, multibody_zmp,
+                                            to_world, torso_yaw)
+from gaitbot.gait.balance.preview import preview_gains, preview_offline
 from gaitbot.gait.balance.settings import BalanceSettings
 from gaitbot.gait.balance.step_plan import (RISE_S, START_PAUSE_S, Landing, PlanBlocks, StepPlanner,
                                            feedforward_weight)
@@ -127,7 +129,7 @@ def leg_of(body: BodyModel) -> LegGeometry:
                        ankle_height=g.ankle_height_m, heel_back=g.heel_back_m)
 
 
-class BalancedWalker:
+class BalancedWalker(Lookahead):
     """Online balanced walker: ``append_step`` plans footholds and the ZMP reference; ``next_frame`` runs
     the preview controllers one frame and places the body: (t_s, q_rad (12,), goal_rad (12,), root_m (3,)),
     or None after the last frame. Like gaitbot.gait.walker.OnlineWalker, a walker whose queue runs dry
@@ -144,6 +146,7 @@ class BalancedWalker:
         self.rate_hz = gait.rate_hz
         self.limits_rad = limits_rad
         self.kp_nm_per_rad = None if kp_nm_per_rad is None else np.asarray(kp_nm_per_rad, dtype=float)
+        self._kp = None if kp_nm_per_rad is None else [float(v) for v in self.kp_nm_per_rad]
         self.feedforward = balance.sag_feedforward and self.kp_nm_per_rad is not None
         self.timing = Timing.of(gait.cycle_s, gait.rate_hz, balance.double_support_share)
         shapes = swing_shapes(leg_of(body), gait.max_step_m, self.timing.cycle_s, gait.rate_hz, gait.clearance_m)
@@ -166,8 +169,9 @@ class BalancedWalker:
         self.planner.hold(self._blocks, self._state, START_PAUSE_S)
         self.finished = False
         self._batch = False
-        self._blocks_done = 0
+        self._base = 0  # the plan's first frame still stored (frames handed out long ago are dropped)
         self._arrays: dict = {}
+        self._pending: tuple[int, int] | None = None  # frames first..last left for work()
         self._commit()
         self._k = 0  # the balance plan's next frame
         self._out = 0  # the walk's next frame (rise, balance plan, lower)
@@ -184,31 +188,38 @@ class BalancedWalker:
         return 1.0 / self.rate_hz
 
     # --- planning ------------------------------------------------------------------------------
-    def append_step(self, length_m: float) -> None:
-        """Queue one step: its foot lands ``length_m`` beyond the previous heel strike."""
+    def append_step(self, length_m: float, spread: bool = False) -> None:
+        """Queue one step: its foot lands ``length_m`` beyond the previous heel strike. ``spread``: see
+        ``work`` (the look-ahead's body placements are redone over the next frames, not at once)."""
         if self.finished:
             raise RuntimeError("the walk has already been closed; start a new walker")
         if not (math.isfinite(length_m) and 0.0 <= length_m <= self.gait.max_step_m + STEP_LENGTH_TOLERANCE_M):
             raise BalancedWalkError(f"step length {length_m!r} m is outside 0..{self.gait.max_step_m:g} m")
         self._record(self.planner.step(self._blocks, self._state, float(length_m)), closing=False)
-        if not self._batch:
-            self._commit()
-            if self._primed:
-                self._replan_lookahead()
+        self._appended(spread)
 
-    def append_footstep(self, foothold: FootPlacement, length_m: float = 0.0) -> None:
+    def append_footstep(self, foothold: FootPlacement, length_m: float = 0.0, spread: bool = False) -> None:
         """Queue one steered step: the next swing foot (``next_swing_side``) lands at ``foothold`` (its
         ankle point and yaw, world); ``length_m`` is recorded as the step's length (its forward part).
-        The planner (gaitbot.gait.steer.planner) has bounded it and checked the feet's clearance."""
+        The planner (gaitbot.gait.steer.planner) has bounded it and checked the feet's clearance.
+        ``spread``: as append_step's."""
         if self.finished:
             raise RuntimeError("the walk has already been closed; start a new walker")
         if not all(math.isfinite(v) for v in (foothold.x_m, foothold.y_m, foothold.yaw_rad, length_m)):
             raise BalancedWalkError(f"foothold {foothold!r} is not finite")
         self._record(self.planner.step_to(self._blocks, self._state, foothold, float(length_m)), closing=False)
+        self._appended(spread)
+
+    def _appended(self, spread: bool) -> None:
         if not self._batch:
             self._commit()
             if self._primed:
-                self._replan_lookahead()
+                self._replan_lookahead(spread)
+
+    @property
+    def planned_frames(self) -> int:
+        """Frames of the balance plan so far (the walk's, without the rise and the lowering)."""
+        return self._committed
 
     def lead_with(self, side: str) -> None:
         """Make ``side`` the first foot to swing (a sidestep or a turn leads with the foot on its side)."""
@@ -276,14 +287,11 @@ class BalancedWalker:
     def _commit(self) -> None:
         """Refresh the plan arrays: the planned frames, then (until the walk is closed) the provisional
         close-and-stand; frames past the end repeat the last one (standing)."""
-        blocks = self._blocks
-        if self._blocks_done == 0:
-            self._arrays = blocks.arrays()
-        elif self._blocks_done < len(blocks.zmp):  # only the blocks added since the last commit
-            new = blocks.arrays(self._blocks_done)
-            self._arrays = {k: np.concatenate([self._arrays[k], new[k]]) for k in self._arrays}
-        self._blocks_done = len(blocks.zmp)
-        self._committed = len(self._arrays["zmp"])
+        if self._blocks.zmp:  # the blocks added since the last commit
+            new = self._blocks.take()
+            self._arrays = new if not self._arrays else {k: np.concatenate([self._arrays[k], new[k]])
+                                                         for k in self._arrays}
+        self._committed = self._base + len(self._arrays["zmp"])
         if self.finished:
             self._ext = self._arrays
         else:
@@ -292,105 +300,40 @@ class BalancedWalker:
             t = tail.arrays()
             self._ext = {k: np.concatenate([self._arrays[k], t[k]]) for k in self._arrays}
         zmp = self._ext["zmp"]
-        self._zmp_padded = np.concatenate([zmp, np.repeat(zmp[-1:], self.gains.horizon_frames + 2, 0)])
+        self._zmp_padded = np.concatenate([zmp, np.repeat(zmp[-1:], self.gains.horizon_frames + 2, 0)])  # from _base
 
     def plan_arrays(self) -> dict:
-        """The plan's per-frame arrays so far (gaitbot.gait.balance.step_plan.PLAN_KEYS)."""
+        """The plan's per-frame arrays so far (gaitbot.gait.balance.step_plan.PLAN_KEYS), from frame
+        ``plan_start_frame`` on (0 until the walker has walked lookahead.STORED_FRAMES frames: then the frames
+        handed out are dropped, bounding the memory of a long walk)."""
         return self._arrays
+
+    @property
+    def plan_start_frame(self) -> int:
+        return self._base
+
+    @property
+    def stored_frames(self) -> int:
+        """The most frames any of the walker's per-frame stores holds (the plan's arrays, the preview
+        stages' errors, points and snapshots): bounded on a walk of any length."""
+        stores = [len(self._ext["zmp"]), len(self._zmp_padded)]
+        if self._primed:
+            stores += [len(self._err), len(self._pts), len(self._s1_com), len(self._s1_snapshot)]
+        return max(stores)
 
     def _ext_at(self, name: str, j: int):
         a = self._ext[name]
-        return a[min(j, len(a) - 1)]
+        return a[min(j - self._base, len(a) - 1)]
 
     def _last_frame(self) -> int:
         """Index of the walk's last frame once closed; unbounded while it is open."""
         return self._committed - 1 if self.finished else 1 << 60
 
-    # --- online --------------------------------------------------------------------------------
-    def _prime(self) -> None:
-        self._flat = FlatFootBody(self.body)
-        self._stage1 = PreviewController(self.gains, self._arrays["zmp"][0])
-        self._stage2 = PreviewController(self.gains, np.zeros(2))
-        self._s1_next = 0
-        self._s1_offset = tuple(self.standing_offset)
-        self._s1_com, self._s1_points, self._s1_snapshot, self._s1_offsets = {}, {}, {}, {}
-        self._err, self._err_next = np.zeros((256, 2)), 0
-        self._offset = tuple(self.standing_offset)
-        self._previous_offset = None
-        self._primed = True
-
-    def _stage1_until(self, j: int) -> None:
-        """Run the first preview stage and place the body up to frame j (clamped to the last frame)."""
-        horizon = self.gains.horizon_frames
-        flat = self._flat
-        while self._s1_next <= min(j, self._last_frame()):
-            i = self._s1_next
-            self._s1_snapshot[i] = (self._stage1.state.copy(), self._stage1.error_sum.copy())
-            com = self._stage1.state[0].copy()
-            self._stage1.step(self._zmp_padded[i], self._zmp_padded[i + 1:i + 1 + horizon])
-            guess = _extrapolated(self._s1_offset, self._s1_offsets.get(i - 2))
-            yaws = self._yaws_at(i)
-            root, q, _ = flat.place(com[0], com[1], self._ext_at("ankles", i), float(self._ext_at("root_z", i)),
-                                    guess[0], guess[1], self.com_slope, PLACEMENT_TOLERANCE_M, MAX_PLACEMENT_ITERATIONS,
-                                    yaws)
-            self._s1_offset = (root[0] - com[0], root[1] - com[1])
-            self._s1_offsets[i] = self._s1_offset
-            self._s1_com[i] = com
-            self._s1_points[i] = np.array(flat.world_points(root, q, yaws))
-            self._s1_next += 1
-
-    def _replan_lookahead(self) -> None:
-        """A step appended while walking: rerun the first stage from the next output frame with the new
-        reference (it had previewed the provisional close-and-stand), re-place those frames at once
-        (vectorised) and let the second stage's errors be recomputed from them."""
-        k = self._k
-        if k not in self._s1_snapshot:
-            return
-        state, error_sum = self._s1_snapshot[k]
-        self._stage1.state, self._stage1.error_sum = state.copy(), error_sum.copy()
-        end = min(self._s1_next - 1, self._last_frame())
-        horizon = self.gains.horizon_frames
-        frames = range(k, end + 1)
-        coms = []
-        for i in frames:
-            self._s1_snapshot[i] = (self._stage1.state.copy(), self._stage1.error_sum.copy())
-            coms.append(self._stage1.state[0].copy())
-            self._stage1.step(self._zmp_padded[i], self._zmp_padded[i + 1:i + 1 + horizon])
-        coms = np.array(coms)
-        idx = np.minimum(np.arange(k, end + 1), len(self._ext["zmp"]) - 1)
-        guess = np.array([self._s1_offsets.get(i, self._s1_offset) for i in frames])
-        yaw = self._ext["yaw"][idx] if self._ext["yaw"][idx].any() else None
-        root, q, _ = self.whole.place(coms, self._ext["ankles"][idx], self._ext["root_z"][idx], guess, self.com_slope,
-                                      yaw)
-        points = self.whole.link_points(root, q, yaw)
-        for n, i in enumerate(frames):
-            self._s1_com[i] = coms[n]
-            self._s1_points[i] = points[n]
-            self._s1_offsets[i] = tuple(root[n, :2] - coms[n])
-        self._s1_offset = (root[-1, 0] - coms[-1, 0], root[-1, 1] - coms[-1, 1])
-        self._err_next = min(self._err_next, k)
-
-    def _points(self, j: int) -> np.ndarray:
-        return self._s1_points[max(0, min(j, self._last_frame()))]
-
-    def _zmp_errors_until(self, j: int) -> None:
-        """Multibody (point-mass) ZMP minus the reference for frames up to j (frames past the end: the
-        last frame's, as the offline padding)."""
-        if len(self._err) <= j:
-            grown = np.zeros((max(2 * len(self._err), j + 1), 2))
-            grown[:self._err_next] = self._err[:self._err_next]
-            self._err = grown
-        last = self._last_frame()
-        masses, dt = self.whole.point_masses_kg, 1.0 / self.rate_hz
-        while self._err_next <= j:
-            i = min(self._err_next, last)
-            if i < self._err_next:
-                self._err[self._err_next] = self._err[i]
-            else:
-                window = np.stack([self._points(i - 1 if i > 0 else 0), self._points(i),
-                                   self._points(i + 1 if i < last else i)])
-                self._err[i] = multibody_zmp(window, masses, dt)[0] - self._ext_at("zmp", i)
-            self._err_next += 1
+    # --- online (the preview stages: gaitbot.gait.balance.lookahead) -----------------------------
+    @property
+    def pending_frames(self) -> int:
+        """Body placements a spread append has left for ``work``."""
+        return 0 if self._pending is None else self._pending[1] - max(self._pending[0], self._k) + 1
 
     def next_frame(self):
         """(t_s, q_rad (12,), goal_rad (12,), root_m (3,)) of the next frame, or None after the last."""
@@ -403,7 +346,7 @@ class BalancedWalker:
             frame = self._balance_frame()
             if frame is None:
                 if self._lower is None:
-                    last = self._committed - 1
+                    last = self._committed - 1 - self._base
                     self._lower = self.straight_path(self._last_root, self._ext["ankles"][last], rising=False,
                                                      yaw=self._ext["yaw"][last])
                 i = j - self.rise_frames - self._committed
@@ -420,7 +363,9 @@ class BalancedWalker:
         if not self._primed:
             self._prime()
         ahead = self.gains.horizon_frames + 2
-        self._stage1_until(math.ceil((j + 1) * ahead / self.rise_frames) - 1)
+        until = math.ceil((j + 1) * ahead / self.rise_frames) - 1
+        self._stage1_until(until)
+        self._zmp_errors_until(min(until - 1, self.gains.horizon_frames))
 
     def _balance_frame(self):
         """The balance plan's next frame: (q, goal, root), or None after its last."""
@@ -434,27 +379,32 @@ class BalancedWalker:
         horizon = self.gains.horizon_frames
         self._stage1_until(k + horizon + 1)
         self._zmp_errors_until(k + horizon)
-        correction = self._stage2.state[0].copy()
-        self._stage2.step(-self._err[k], -self._err[k + 1:k + 1 + horizon])
-        com = self._s1_com[k] + correction
+        stage2 = self._stage2
+        correction = stage2.com
+        e = self._err[k - self._base:k - self._base + horizon + 2]
+        (px, py), = stage2.preview_sums(e, 0, 1).tolist()
+        stage2.step(-e[0, 0], -e[0, 1], -px, -py)
+        s1 = self._s1_com[k]
+        com = (s1[0] + correction[0], s1[1] + correction[1])
         flat = self._flat
-        guess = _extrapolated(self._offset, self._previous_offset)
+        guess = extrapolated(self._offset, self._previous_offset)
         yaws = self._yaws_at(k)
         root, q, _ = flat.place(com[0], com[1], self._ext_at("ankles", k), float(self._ext_at("root_z", k)),
                                 guess[0], guess[1], self.com_slope, PLACEMENT_TOLERANCE_M, MAX_PLACEMENT_ITERATIONS,
                                 yaws)
         self._previous_offset = self._offset
         self._offset = (root[0] - com[0], root[1] - com[1])
-        for cache in (self._s1_com, self._s1_points, self._s1_snapshot, self._s1_offsets):  # drop the past
+        for cache in (self._s1_com, self._s1_snapshot, self._s1_offsets):  # drop the past
             cache.pop(k - 2, None)
         goal = q
         if self.feedforward:
             torque = self._gravity_torques(q, root, k, yaws)
             last = self._committed - 1 if self.finished else math.inf
             w = float(feedforward_weight(k, last, self.rate_hz))
-            goal = [a + w * t / kp for a, t, kp in zip(q, torque, self.kp_nm_per_rad)]
+            goal = [a + w * t / kp for a, t, kp in zip(q, torque, self._kp)]
         self._k += 1
         self._last_root = np.array(root)
+        self._trim()
         return np.array(q), np.array(goal), np.array(root)
 
     def _yaws_at(self, i: int):
@@ -463,26 +413,18 @@ class BalancedWalker:
         return None if yaw[0] == 0.0 and yaw[1] == 0.0 else (float(yaw[0]), float(yaw[1]))
 
     def _gravity_torques(self, q, root, k: int, yaws):
-        """The sag feedforward's joint torques at plan frame k (the float code; turned feet: the mass model's,
-        with the feet's centres of pressure in the turned torso's frame)."""
-        cops = self._arrays["cops"][k]
-        share = smoothed_share(self._ext["share_left"], self.rate_hz, k)
+        """The sag feedforward's joint torques at plan frame k (the float code; turned feet: the feet's
+        centres of pressure in the turned torso's frame)."""
+        cops = self._arrays["cops"][k - self._base]
+        share = smoothed_share(self._ext["share_left"], self.rate_hz, k - self._base)
         if yaws is None:
             return self._flat.gravity_torques(q, share, ((cops[0, 0] - root[0], cops[0, 1] - root[1]),
                                                          (cops[1, 0] - root[0], cops[1, 1] - root[1])))
         psi = 0.5 * (yaws[0] + yaws[1])
         c, sn = math.cos(psi), math.sin(psi)
-        local = [(c * (x - root[0]) + sn * (y - root[1]), -sn * (x - root[0]) + c * (y - root[1]), -root[2])
-                 for x, y in cops]
-        return list(self.whole.mass.gravity_torques(np.array(q), share, local[0], local[1]))
-
-
-def _extrapolated(offset, previous) -> tuple[float, float]:
-    """The next frame's root - CoM offset guessed from the last two (the placement then needs 2 to 3
-    iterations instead of 4 to 5)."""
-    if previous is None:
-        return offset
-    return 2 * offset[0] - previous[0], 2 * offset[1] - previous[1]
+        local = [(c * (x - root[0]) + sn * (y - root[1]), -sn * (x - root[0]) + c * (y - root[1]))
+                 for x, y in cops.tolist()]
+        return self._flat.gravity_torques(q, share, local)
 
 
 def plan_balanced_walk(body: BodyModel, step_lengths, gait: BalancedGaitSettings,

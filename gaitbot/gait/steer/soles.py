@@ -42,16 +42,36 @@ def _point_segment(px, py, ax, ay, bx, by) -> float:
     return math.hypot(ax + t * ex - px, ay + t * ey - py)
 
 
+def _edges(poly) -> list[tuple[float, float, float, float, float]]:
+    """Each edge of a polygon as (ax, ay, ex, ey, |e|): its start and its vector."""
+    n = len(poly)
+    out = []
+    for k in range(n):
+        (ax, ay), (bx, by) = poly[k], poly[(k + 1) % n]
+        out.append((ax, ay, bx - ax, by - ay, math.hypot(bx - ax, by - ay)))
+    return out
+
+
 def _depth(px, py, poly) -> float:
     """How far (px, py) lies inside a counter-clockwise convex polygon (<= 0: outside or on its edge)."""
-    depth = math.inf
-    n = len(poly)
-    for k in range(n):
-        ax, ay = poly[k]
-        bx, by = poly[(k + 1) % n]
-        ex, ey = bx - ax, by - ay
-        depth = min(depth, (ex * (py - ay) - ey * (px - ax)) / math.hypot(ex, ey))
-    return depth
+    return min((ex * (py - ay) - ey * (px - ax)) / length for ax, ay, ex, ey, length in _edges(poly))
+
+
+def _deepest(points, edges) -> tuple[float, bool]:
+    """The deepest of ``points`` inside the polygon of ``edges`` (as _depth), and whether all of them lie
+    strictly outside one of its edges (then the polygons are apart: no edges cross)."""
+    deepest = -math.inf
+    for px, py in points:
+        depth = math.inf
+        for ax, ay, ex, ey, length in edges:
+            d = (ex * (py - ay) - ey * (px - ax)) / length
+            if d < depth:
+                depth = d
+        if depth > deepest:
+            deepest = depth
+    apart = any(all(ex * (py - ay) - ey * (px - ax) < -COLLINEAR_M2 for px, py in points)
+                for ax, ay, ex, ey, _ in edges)
+    return deepest, apart
 
 
 COLLINEAR_M2 = 1e-15
@@ -73,19 +93,27 @@ def _cross(p, q) -> bool:
     return False
 
 
-def polygon_gap(p, q) -> float:
+def polygon_gap(p, q, p_edges=None) -> float:
     """Least distance between convex counter-clockwise polygons p and q (lists of (x, y)); negative if
-    they overlap (minus the deepest corner's depth; edges crossing with no corner inside: 0)."""
-    depth = max(max(_depth(x, y, q) for x, y in p), max(_depth(x, y, p) for x, y in q))
+    they overlap (minus the deepest corner's depth; edges crossing with no corner inside: 0).
+    p_edges: p's _edges when the caller has them (a sweep against one stance sole)."""
+    ep = _edges(p) if p_edges is None else p_edges
+    eq = _edges(q)
+    deep_p, apart_q = _deepest(p, eq)
+    deep_q, apart_p = _deepest(q, ep)
+    depth = max(deep_p, deep_q)
     if depth > 0:
         return -depth
     gap = math.inf
-    for a, b in ((p, q), (q, p)):
-        n = len(b)
-        for x, y in a:
-            for k in range(n):
-                gap = min(gap, _point_segment(x, y, *b[k], *b[(k + 1) % n]))
-    return 0.0 if _cross(p, q) else gap
+    for points, edges in ((p, eq), (q, ep)):
+        for x, y in points:
+            for ax, ay, ex, ey, _ in edges:
+                t = ((x - ax) * ex + (y - ay) * ey) / (ex * ex + ey * ey)
+                t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
+                d = math.hypot(ax + t * ex - x, ay + t * ey - y)
+                if d < gap:
+                    gap = d
+    return 0.0 if not (apart_p or apart_q) and _cross(p, q) else gap
 
 
 def sole_gap_m(geometry: BodyGeometry, a: FootPlacement, b: FootPlacement) -> float:
@@ -103,5 +131,6 @@ def between(old: FootPlacement, new: FootPlacement, share: float) -> FootPlaceme
 def swept_gap_m(geometry: BodyGeometry, stance: FootPlacement, old: FootPlacement, new: FootPlacement) -> float:
     """The least gap between the stance sole and the swing sole along the swing's path."""
     box = sole_box(geometry, stance)
-    return min(polygon_gap(box, sole_box(geometry, between(old, new, k / (SWEEP_SAMPLES - 1))))
+    edges = _edges(box)
+    return min(polygon_gap(box, sole_box(geometry, between(old, new, k / (SWEEP_SAMPLES - 1))), edges)
                for k in range(SWEEP_SAMPLES))

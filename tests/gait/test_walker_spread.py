@@ -1,0 +1,91 @@
+"""The balanced walker's own costs: a replan spread over frames walks (nearly) the frames of one done at once,
+and a walk of any length holds bounded memory (the plan behind the output is dropped, frames unchanged)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import gaitbot.gait.balance.lookahead as lookahead
+from gaitbot.app.options import load_robot
+from gaitbot.gait.steer.command import VelocityCommand
+from gaitbot.robot.balanced_walk import balanced_gait_settings, balanced_walker
+from gaitbot.robot.steered_walk import footstep_planner
+
+OP3 = load_robot("op3")
+GAIT = balanced_gait_settings(OP3)
+COMMANDS = [VelocityCommand(0.05, 0.0, 0.0), VelocityCommand(0.0, 0.03, 0.0), VelocityCommand(0.03, 0.0, 15.0),
+            VelocityCommand(-0.03, 0.0, 0.0), VelocityCommand(0.0, -0.03, -10.0)]
+SPREAD_TOLERANCE_DEG = 0.1
+"""The spread walk's angles against the at-once walk's: measured 0.05 deg at most (a sidestep), about half an
+OP3 servo's tick (0.088 deg)."""
+
+
+def steered_walk(spread: bool, steps: int, per_command: int = 4):
+    """Frames of a steered OP3 walk, each step appended (as the drive does) once the one before has started."""
+    walker = balanced_walker(OP3, GAIT)
+    planner = footstep_planner(OP3, GAIT)
+    walker.lead_with("left")
+    frames, n = [], 0
+    while True:
+        now = walker._out / walker.rate_hz
+        if n < steps and not any(s.start_s >= now for s in walker.planned_steps[-1:]):
+            step = planner.next_step(COMMANDS[(n // per_command) % len(COMMANDS)], walker.next_swing_side)
+            walker.append_footstep(step.foothold, max(0.0, step.length_m), spread=spread)
+            n += 1
+        elif spread:
+            walker.work()
+        frame = walker.next_frame()
+        if frame is None:
+            return walker, frames
+        frames.append(frame)
+
+
+def test_a_spread_replan_walks_the_frames_of_one_done_at_once():
+    at_once, a = steered_walk(False, 20)
+    spread, b = steered_walk(True, 20)
+    assert spread.heel_strikes == at_once.heel_strikes  # the same footholds, exactly
+    assert len(a) == len(b)
+    q_a, q_b = np.array([f[1] for f in a]), np.array([f[1] for f in b])
+    assert math.degrees(np.abs(q_a - q_b).max()) < SPREAD_TOLERANCE_DEG
+    assert np.abs(np.array([f[3] for f in a]) - np.array([f[3] for f in b])).max() < 0.5e-3  # root, m
+    assert np.abs(q_b).max() > 0.3  # it did walk
+
+
+def test_dropping_the_plan_behind_the_output_changes_no_frame(monkeypatch):
+    _, kept = steered_walk(True, 12, per_command=3)
+    monkeypatch.setattr(lookahead, "STORED_FRAMES", 60)
+    walker, trimmed = steered_walk(True, 12, per_command=3)
+    assert walker.plan_start_frame > 300  # it did drop
+    assert walker.stored_frames < 60 + 3 * walker.gains.horizon_frames
+    for i in (1, 2, 3):
+        assert np.array_equal(np.array([f[i] for f in kept]), np.array([f[i] for f in trimmed]))
+
+
+@pytest.mark.slow
+def test_twenty_minutes_of_walking_hold_bounded_memory():
+    """A long walk without a stop, on the walker's own clock (no sleeping): its stores stay bounded."""
+    walker = balanced_walker(OP3, GAIT)
+    planner = footstep_planner(OP3, GAIT)
+    walker.lead_with("left")
+    rng = np.random.default_rng(1)
+    command, sizes = COMMANDS[0], []
+    frames = round(20 * 60 * walker.rate_hz)
+    for j in range(frames):
+        if j % 180 == 0:
+            command = COMMANDS[int(rng.integers(len(COMMANDS)))]
+        now = walker._out / walker.rate_hz
+        if not any(s.start_s >= now for s in walker.planned_steps[-1:]):
+            step = planner.next_step(command, walker.next_swing_side)
+            walker.append_footstep(step.foothold, max(0.0, step.length_m), spread=True)
+        else:
+            walker.work()
+        assert walker.next_frame() is not None
+        if j % 600 == 0:
+            sizes.append(walker.stored_frames)
+    bound = lookahead.STORED_FRAMES + lookahead.RESERVE_FRAMES + 3 * walker.gains.horizon_frames
+    assert max(sizes) <= bound
+    assert walker.plan_start_frame > frames - lookahead.STORED_FRAMES - walker.rise_frames
+
