@@ -298,6 +298,11 @@ class BalancedWalker:
         """The plan's per-frame arrays so far (gaitbot.gait.balance.step_plan.PLAN_KEYS)."""
         return self._arrays
 
+    def last_torso_yaw_rad(self) -> float:
+        """The torso's yaw (rad, the walker's world) in the frame ``next_frame`` gave last: the mean of the
+        feet's yaws at that plan frame (while rising: the first; while lowering: the last). For the view."""
+        return float(torso_yaw(self._ext_at("yaw", max(self._k - 1, 0))))
+
     def _ext_at(self, name: str, j: int):
         a = self._ext[name]
         return a[min(j, len(a) - 1)]
