@@ -70,10 +70,10 @@ def subscriber(port: int, stop: threading.Event) -> threading.Thread:
     return thread
 
 
-def measure(frames: PlannedFrames, geometry, sinks, threaded: bool = True, repeats: int = 3) -> np.ndarray:
+def measure(frames: PlannedFrames, config, sinks, threaded: bool = True, repeats: int = 3) -> np.ndarray:
     """Microseconds per observer call: the call the loop makes (threaded: what walk and drive use), or the
     encoding and writing itself (not threaded: the worker thread's own cost per frame)."""
-    publisher = TelemetryPublisher(geometry, sinks)
+    publisher = TelemetryPublisher(config, sinks)
     if threaded:
         publisher = BackgroundPublisher(publisher)
     health = ServoHealth(0, "servo health over 100 reads", 31.0, 12.0, 20.0)
@@ -101,12 +101,12 @@ def main() -> None:
                 ("loop: --mcap", [McapSink(Path(tmp) / "b.mcap")], True),
                 ("loop: --foxglove, no client", [FoxgloveSink("127.0.0.1", 0)], True)]
         for name, sinks, threaded in rows:
-            _row(name, measure(frames, geometry, sinks, threaded))
+            _row(name, measure(frames, config, sinks, threaded))
         live = FoxgloveSink("127.0.0.1", 0)
         stop = threading.Event()
         client = subscriber(live.port, stop)
         time.sleep(0.5)
-        _row("loop: --foxglove + client, --mcap", measure(frames, geometry, [live, McapSink(Path(tmp) / "c.mcap")]))
+        _row("loop: --foxglove + client, --mcap", measure(frames, config, [live, McapSink(Path(tmp) / "c.mcap")]))
         stop.set()
         client.join(2.0)
 

@@ -112,7 +112,7 @@ def open_view(args, config, goals, planned=None, health=None, realtime: bool = T
     from gaitbot.view.publisher import BackgroundPublisher, TelemetryPublisher
     from gaitbot.view.walk_frames import PlannedFrames
 
-    publisher = BackgroundPublisher(TelemetryPublisher(config.body.geometry, sinks), lossless=not realtime)
+    publisher = BackgroundPublisher(TelemetryPublisher(config, sinks), lossless=not realtime)
     view = WalkView(publisher, PlannedFrames(config, goals, planned), teleop)
     view.health = health
     return view
@@ -148,7 +148,7 @@ class DriveView:
         from gaitbot.view.publisher import BackgroundPublisher, TelemetryPublisher
         from gaitbot.view.telemetry import health_of
 
-        telemetry = DriveTelemetry(self.config, TelemetryPublisher(self.config.body.geometry, self.sinks))
+        telemetry = DriveTelemetry(self.config, TelemetryPublisher(self.config, self.sinks))
         self.publisher = publisher = BackgroundPublisher(telemetry, lossless=not realtime)
         self.sinks = []
 
