@@ -21,6 +21,7 @@ websockets = pytest.importorskip("websockets")
 
 from gaitbot.check.balance import signed_distance  # noqa: E402
 from gaitbot.robot.calibration import angles_to_ticks  # noqa: E402
+from gaitbot.robot.description.urdf_writer import urdf_text  # noqa: E402
 from gaitbot.view.ros2_messages import decoder  # noqa: E402
 from helpers import REPO_ROOT, config, goal_line_indices, read_lines, run_cli, split_sync_write  # noqa: E402
 from mcap.reader import make_reader  # noqa: E402
@@ -96,11 +97,12 @@ async def steer(url: str, twist_s: float) -> dict:
     async with websockets.connect(url, subprotocols=["foxglove.sdk.v1", "foxglove.websocket.v1"],
                                   open_timeout=BOUND_S) as ws:
         channels = {}
-        while not {"/joint_goals", "/tf"} <= set(channels):  # advertised once the drive's frames flow
+        wanted = {"/joint_goals", "/tf", "/tf_static", "/robot_description"}
+        while not wanted <= set(channels):  # advertised once the drive's frames flow
             message = json.loads(await asyncio.wait_for(ws.recv(), BOUND_S))
             if message["op"] == "advertise":
                 channels.update({c["topic"]: c for c in message["channels"]})
-        subscriptions = {1: "/joint_goals", 2: "/tf"}
+        subscriptions = {1: "/joint_goals", 2: "/tf", 3: "/tf_static", 4: "/robot_description"}
         await ws.send(json.dumps({"op": "subscribe", "subscriptions": [
             {"id": sid, "channelId": channels[topic]["id"]} for sid, topic in subscriptions.items()]}))
         await ws.send(json.dumps({"op": "advertise", "channels": [
@@ -148,3 +150,6 @@ def test_a_foxglove_client_watches_and_steers_a_simulated_drive():
     tf = got["/tf"].transforms
     assert (tf[0].header.frame_id, tf[0].child_frame_id) == ("odom", "base_link")
     assert {t.child_frame_id for t in tf[1:]} >= {"foot_left", "foot_right"}
+    # a client that connected after the start still gets the robot to draw (sent again every 2 s)
+    assert got["/robot_description"].data == urdf_text(config("op3"))
+    assert {"left_foot", "right_foot", "trunk"} <= {t.child_frame_id for t in got["/tf_static"].transforms}
