@@ -109,14 +109,17 @@ async def steer(url: str, twist_s: float) -> dict:
             {"id": 7, "topic": "/cmd_vel", "encoding": "json", "schemaName": "geometry_msgs/msg/Twist"}]}))
         twist = json.dumps({"linear": {"x": 0.04, "y": 0.0, "z": 0.0}, "angular": {"x": 0.0, "y": 0.0, "z": 0.0}})
         end = time.monotonic() + twist_s
-        while time.monotonic() < end:
-            await ws.send(b"\x01" + struct.pack("<I", 7) + twist.encode())
+        while time.monotonic() < end or not set(subscriptions.values()) <= set(got):  # the drive's end closes it
+            if time.monotonic() < end:
+                await ws.send(b"\x01" + struct.pack("<I", 7) + twist.encode())
             next_send = time.monotonic() + 0.1  # 10 Hz, well above the watchdog's 2 Hz
             while (left := next_send - time.monotonic()) > 0:
                 try:
                     message = await asyncio.wait_for(ws.recv(), left)
                 except asyncio.TimeoutError:
                     break
+                except websockets.ConnectionClosed:
+                    return got
                 if isinstance(message, bytes) and message[0] == 0x01:  # MessageData
                     sid, _ = struct.unpack_from("<IQ", message, 1)
                     topic = subscriptions[sid]
