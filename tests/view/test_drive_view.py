@@ -23,7 +23,7 @@ from gaitbot.check.balance import signed_distance  # noqa: E402
 from gaitbot.robot.calibration import angles_to_ticks  # noqa: E402
 from gaitbot.robot.description.urdf_writer import urdf_text  # noqa: E402
 from gaitbot.view.ros2_messages import decoder  # noqa: E402
-from helpers import REPO_ROOT, config, goal_line_indices, read_lines, run_cli, split_sync_write  # noqa: E402
+from helpers import REPO_ROOT, config, recorded_goal_ticks, run_cli  # noqa: E402
 from mcap.reader import make_reader  # noqa: E402
 from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 
@@ -58,12 +58,7 @@ def test_a_drive_mcap_holds_every_channel_at_the_frame_rate(tmp_path, capsys):
         assert np.allclose(np.diff([t for t, *_ in log[topic]]), 1e9 / 60, atol=1), topic
     # the goals logged, turned into ticks, are the goal packets the mock bus recorded, frame for frame
     cfg = config("op3")
-    rows = read_lines(record)
-    sent = []
-    for k in goal_line_indices(rows, "op3"):
-        _, _, entries = split_sync_write(rows[0], bytes.fromhex(rows[k]["hex"]))
-        ticks = dict((i, int.from_bytes(d, "little")) for i, d in entries)
-        sent.append([ticks[j.id] for j in cfg.joints])
+    sent = recorded_goal_ticks(record, "op3", cfg.joints)
     logged = [list(angles_to_ticks(cfg, np.array(m.position), m.name)) for *_, m in log["/joint_goals"]]
     start = sent.index(logged[1]) - 1
     assert sent[start:start + len(logged)] == logged

@@ -17,7 +17,7 @@ from gaitbot.view.channels import CHANNELS, STATIC_CHANNELS  # noqa: E402
 from gaitbot.view.mcap_log import McapSink  # noqa: E402
 from gaitbot.view.publisher import TelemetryPublisher  # noqa: E402
 from gaitbot.view.telemetry import FrameTelemetry, ImuSample, ServoHealth  # noqa: E402
-from helpers import config, goal_line_indices, read_lines, run_cli, split_sync_write  # noqa: E402
+from helpers import config, recorded_goal_ticks, run_cli  # noqa: E402
 
 START_NS = 1_700_000_000_000_000_000
 
@@ -94,12 +94,7 @@ def test_walk_mcap_holds_every_channel_at_the_frame_rate_and_the_goals_the_servo
         assert np.allclose(np.diff(times), 1e9 / 60, atol=1), topic
     # the goals logged, turned into ticks, are the goal packets the mock bus recorded, frame for frame
     cfg = config("op3")
-    rows = read_lines(record)
-    sent = []
-    for k in goal_line_indices(rows, "op3"):
-        _, length, entries = split_sync_write(rows[0], bytes.fromhex(rows[k]["hex"]))
-        ticks = dict((i, int.from_bytes(d, "little")) for i, d in entries)
-        sent.append([ticks[j.id] for j in cfg.joints])
+    sent = recorded_goal_ticks(record, "op3", cfg.joints)
     logged = [list(angles_to_ticks(cfg, np.array(m.position), m.name)) for *_, m in log["/joint_goals"]]
     start = sent.index(logged[1]) - 1
     assert sent[start:start + len(logged)] == logged
