@@ -104,7 +104,8 @@ def gaitbot_walk(config, scenario: Scenario) -> tuple[Walk, list, object]:
         rpy[:, 2] = walk.torso_yaw_rad
     goals = Trajectory(walk.t_s, walk.goals_rad, walk.root_m, joints=LEG_JOINTS, torso_rpy_rad=rpy)
     planned = Trajectory(walk.t_s, walk.q_rad, walk.root_m, joints=LEG_JOINTS, torso_rpy_rad=rpy)
-    return Walk(goals, planned, len(steps), total_ms / len(steps), total_ms / len(walk.t_s), walk.zmp_plan_m), steps, plan
+    walked = Walk(goals, planned, len(steps), total_ms / len(steps), total_ms / len(walk.t_s), walk.zmp_plan_m)
+    return walked, steps, plan
 
 
 def sole_frame(config, foothold) -> np.ndarray:
@@ -212,10 +213,10 @@ def peak_velocity_dps(walk: Walk) -> float:
 
 def planned_motion(walk: Walk) -> tuple[float, float, float]:
     """The plan's pelvis displacement (forward, left m, in the start's frame) and turn (deg)."""
-    root, yaw0 = walk.planned.root_m, 0.0
-    d = root[-1, :2] - root[0, :2]
-    turn = 0.0 if walk.planned.torso_rpy_rad is None else float(walk.planned.torso_rpy_rad[-1, 2] - walk.planned.torso_rpy_rad[0, 2])
-    return float(d[0] * math.cos(yaw0) + d[1] * math.sin(yaw0)), float(d[1]), math.degrees(turn)
+    d = walk.planned.root_m[-1, :2] - walk.planned.root_m[0, :2]
+    rpy = walk.planned.torso_rpy_rad
+    turn = 0.0 if rpy is None else float(rpy[-1, 2] - rpy[0, 2])
+    return float(d[0]), float(d[1]), math.degrees(turn)
 
 
 def play_gaitbot_sim(config, walk: Walk) -> tuple[float, float, float, bool]:

@@ -107,7 +107,8 @@ def run(args) -> int:
     top, bottom = command_limits(config.steer, step_s)
     view = open_drive_view(args, config)  # --mcap, --foxglove (gaitbot.app.view_options)
     try:
-        commands_out = open(args.record_commands, "w", encoding="utf-8") if args.record_commands else None  # noqa: SIM115
+        commands_out = (open(args.record_commands, "w", encoding="utf-8")  # noqa: SIM115
+                        if args.record_commands else None)
         source = view.teleop if args.input == FOXGLOVE_INPUT else open_source(args.input, top, bottom)
         try:
             return _drive(args, config, source, commands_out, view)

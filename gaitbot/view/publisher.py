@@ -55,7 +55,8 @@ class TelemetryPublisher:
         for topic, message, *first in messages:
             type_name = CHANNELS[topic]
             data = self.encoders[type_name](message)
-            sinks = self.sinks if not first or first[0] else [s for s in self.sinks if getattr(s, "repeats_static", False)]
+            sinks = (self.sinks if not first or first[0]
+                     else [s for s in self.sinks if getattr(s, "repeats_static", False)])
             for sink in list(sinks):
                 try:
                     sink.write(topic, type_name, data, stamp_ns)
