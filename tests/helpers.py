@@ -127,6 +127,17 @@ def goal_line_indices(rows: list[dict], robot: str) -> list[int]:
     return out
 
 
+def recorded_goal_ticks(record: Path, robot: str, joints) -> list[list[int]]:
+    """Each goal-position sync write of a bus recording as ticks in the order of ``joints`` (config joints)."""
+    rows = read_lines(record)
+    sent = []
+    for k in goal_line_indices(rows, robot):
+        _, _, entries = split_sync_write(rows[0], bytes.fromhex(rows[k]["hex"]))
+        ticks = dict((i, int.from_bytes(d, "little")) for i, d in entries)
+        sent.append([ticks[j.id] for j in joints])
+    return sent
+
+
 def goal_row_near(rows: list[dict], robot: str, t_s: float) -> int:
     """Index of the goal sync write whose time is closest to ``t_s``."""
     return min(goal_line_indices(rows, robot), key=lambda k: abs(rows[k]["t"] - t_s))

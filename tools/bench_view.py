@@ -7,7 +7,9 @@ calls it, the observer takes each frame's record. "loop" rows: what the call cos
 record queued for the worker thread, gaitbot.view.publisher.BackgroundPublisher); "worker" rows: the
 worker's own cost per frame (every channel encoded to CDR and written). Sinks: none, an MCAP file, the
 Foxglove server with no client, and with a loopback client subscribed to every channel (its own thread,
-as Foxglove would be). Machine-dependent figures.
+as Foxglove would be). "worker: drive record": a drive's frame made on the worker (gaitbot.view.
+drive_telemetry: goals from the ticks, CoM, ZMP, soles and support over three frames) and encoded.
+Machine-dependent figures.
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ from gaitbot.app.options import load_robot  # noqa: E402
 from gaitbot.gait.joints import LEG_JOINTS  # noqa: E402
 from gaitbot.gait.trajectory import Trajectory  # noqa: E402
 from gaitbot.robot.balanced_walk import plan_balanced  # noqa: E402
+from gaitbot.robot.calibration import angles_to_ticks  # noqa: E402
+from gaitbot.view.drive_telemetry import DriveSample, DriveTelemetry  # noqa: E402
 from gaitbot.view.live import FoxgloveSink  # noqa: E402
 from gaitbot.view.mcap_log import McapSink  # noqa: E402
 from gaitbot.view.publisher import BackgroundPublisher, TelemetryPublisher  # noqa: E402
@@ -60,6 +64,8 @@ def subscriber(port: int, stop: threading.Event) -> threading.Thread:
                     message = await asyncio.wait_for(ws.recv(), 0.1)
                 except asyncio.TimeoutError:
                     continue
+                except websockets.ConnectionClosed:  # the walk ended and its server with it
+                    return
                 if isinstance(message, str) and json.loads(message)["op"] == "advertise":
                     subs = [{"id": next_id + i, "channelId": c["id"]} for i, c in enumerate(json.loads(message)["channels"])]
                     next_id += len(subs)
@@ -70,10 +76,10 @@ def subscriber(port: int, stop: threading.Event) -> threading.Thread:
     return thread
 
 
-def measure(frames: PlannedFrames, geometry, sinks, threaded: bool = True, repeats: int = 3) -> np.ndarray:
+def measure(frames: PlannedFrames, config, sinks, threaded: bool = True, repeats: int = 3) -> np.ndarray:
     """Microseconds per observer call: the call the loop makes (threaded: what walk and drive use), or the
     encoding and writing itself (not threaded: the worker thread's own cost per frame)."""
-    publisher = TelemetryPublisher(geometry, sinks)
+    publisher = TelemetryPublisher(config, sinks)
     if threaded:
         publisher = BackgroundPublisher(publisher)
     health = ServoHealth(0, "servo health over 100 reads", 31.0, 12.0, 20.0)
@@ -93,7 +99,6 @@ def main() -> None:
     plan = plan_balanced(config, STEPS_M)
     goals = Trajectory(plan.walk.t_s, plan.walk.goals_rad, plan.walk.root_m, plan.walk.heel_strikes, LEG_JOINTS)
     frames = PlannedFrames(config, goals, plan.walk.trajectory())
-    geometry = config.body.geometry
     print(f"{ROBOT}, {len(frames)} frames at 60 Hz x 3, microseconds per frame: p50 / p99 / max")
     with tempfile.TemporaryDirectory() as tmp:
         rows = [("worker: encode only", [NullSink()], False),
@@ -101,14 +106,29 @@ def main() -> None:
                 ("loop: --mcap", [McapSink(Path(tmp) / "b.mcap")], True),
                 ("loop: --foxglove, no client", [FoxgloveSink("127.0.0.1", 0)], True)]
         for name, sinks, threaded in rows:
-            _row(name, measure(frames, geometry, sinks, threaded))
+            _row(name, measure(frames, config, sinks, threaded))
+        _row("worker: drive record + encode", measure_drive(config, plan.walk))
         live = FoxgloveSink("127.0.0.1", 0)
         stop = threading.Event()
         client = subscriber(live.port, stop)
         time.sleep(0.5)
-        _row("loop: --foxglove + client, --mcap", measure(frames, geometry, [live, McapSink(Path(tmp) / "c.mcap")]))
+        _row("loop: --foxglove + client, --mcap", measure(frames, config, [live, McapSink(Path(tmp) / "c.mcap")]))
         stop.set()
         client.join(2.0)
+
+
+def measure_drive(config, walk, repeats: int = 3) -> np.ndarray:
+    """Microseconds per DriveTelemetry.on_frame (the worker's work for a drive's frame), NullSink."""
+    ticks = angles_to_ticks(config, walk.goals_rad, LEG_JOINTS)
+    cost = []
+    for _ in range(repeats):
+        telemetry = DriveTelemetry(config, TelemetryPublisher(config, [NullSink()]))
+        for k in range(len(walk.t_s)):
+            sample = DriveSample(float(walk.t_s[k]), ticks[k], walk.q_rad[k], walk.root_m[k], 0.0, (0.1, 0.0, 0.0))
+            start = time.perf_counter()
+            telemetry.on_frame(sample)
+            cost.append(time.perf_counter() - start)
+    return np.array(cost) * 1e6
 
 
 def _row(name: str, c: np.ndarray) -> None:

@@ -4,6 +4,7 @@ hands the drive to gaitbot.app.drive_run (numpy, the walker, the bus). docs/driv
 from __future__ import annotations
 
 from gaitbot.app.arguments import add_command
+from gaitbot.app.view_options import add_view_options
 
 
 def add_parser(subparsers):
@@ -11,8 +12,9 @@ def add_parser(subparsers):
     p = add_command(subparsers, "drive")
     p.add_argument("--robot", help="robot config: a name in config/ or a .toml file (default xl430-biped)")
     p.add_argument("--calibration", metavar="FILE", help="calibration file applied on top of the robot config")
-    p.add_argument("--input", default="keyboard", metavar="SOURCE",
-                   help="keyboard (default), gamepad[:DEVICE], udp:[HOST:]PORT or commands:FILE")
+    p.add_argument("--input", metavar="SOURCE",
+                   help="keyboard (default), gamepad[:DEVICE], udp:[HOST:]PORT, commands:FILE or foxglove (the Teleop "
+                   "panel's Twists on /cmd_vel; the default with --foxglove)")
     p.add_argument("--port", help="serial port of the robot (default: the config's)")
     p.add_argument("--dry-run", action="store_true", help="drive the mock bus under the real SDK: no hardware")
     p.add_argument("--sim", action="store_true", help="drive the simulated robot (MuJoCo, free-floating)")
@@ -23,6 +25,7 @@ def add_parser(subparsers):
     p.add_argument("--max-time", type=float, metavar="S", help="stop (to standing) after this many seconds")
     p.add_argument("--json", action="store_true", help="print the final report as one JSON object")
     p.add_argument("--reply-timeout-ms", type=float, metavar="MS", help="status packet timeout")
+    add_view_options(p)  # --mcap, --foxglove (gaitbot.app.view_options)
     return p
 
 

@@ -18,6 +18,7 @@ import threading
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, load_robot
 from gaitbot.app.outputs import output_path
+from gaitbot.app.view_options import FOXGLOVE_INPUT, drive_input, open_drive_view
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.recording import BusRecorder
 from gaitbot.drive.frames import DriveFrames, command_limits
@@ -96,6 +97,7 @@ def _status_line(frames: DriveFrames, health: HealthMonitor):
 
 
 def run(args) -> int:
+    drive_input(args)  # --input left out: foxglove with --foxglove, else keyboard
     _check_args(args)
     refuse_port_in_dry_run(args)
     config = load_robot(args.robot, getattr(args, "calibration", None))
@@ -103,17 +105,23 @@ def run(args) -> int:
         raise UsageError(f"--robot {args.robot or config.name}: {config.name} has no [steer] table: it cannot be driven")
     step_s = footstep_planner(config).step_s
     top, bottom = command_limits(config.steer, step_s)
-    commands_out = open(args.record_commands, "w", encoding="utf-8") if args.record_commands else None  # noqa: SIM115
-    source = open_source(args.input, top, bottom)
+    view = open_drive_view(args, config)  # --mcap, --foxglove (gaitbot.app.view_options)
     try:
-        return _drive(args, config, source, commands_out)
+        commands_out = (open(args.record_commands, "w", encoding="utf-8")  # noqa: SIM115
+                        if args.record_commands else None)
+        source = view.teleop if args.input == FOXGLOVE_INPUT else open_source(args.input, top, bottom)
+        try:
+            return _drive(args, config, source, commands_out, view)
+        finally:
+            source.close()
+            if commands_out is not None:
+                commands_out.close()
     finally:
-        source.close()
-        if commands_out is not None:
-            commands_out.close()
+        if view is not None:
+            view.close()
 
 
-def _drive(args, config, source, commands_out) -> int:
+def _drive(args, config, source, commands_out, view=None) -> int:
     def on_command(timed) -> None:
         if commands_out is not None:
             commands_out.write(timed.to_json() + "\n")
@@ -134,7 +142,7 @@ def _drive(args, config, source, commands_out) -> int:
         recorder = BusRecorder(args.record, robot=config.name, joints={j.name: j.id for j in config.joints},
                                clock=clock.now, rate_hz=1.0 / frames.period_s)
     try:
-        bus = (guarded(config, sim.make_bus(clock.now, recorder)) if sim is not None else
+        bus = (guarded(config, sim.make_bus(_from_zero(clock), recorder)) if sim is not None else
                make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,
                               reply_timeout_ms=args.reply_timeout_ms, clock=clock.now))
     except OSError as exc:
@@ -146,7 +154,7 @@ def _drive(args, config, source, commands_out) -> int:
             result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
                                   max_accel_ticks_per_s2=acceleration, period_s=frames.period_s, clock=clock,
                                   torque_off_on_exit=config.bus.torque_off_on_exit,
-                                  on_frame=_status_line(frames, health), handle_sigterm=False,
+                                  on_frame=_on_frame(view, frames, health, clock), handle_sigterm=False,
                                   setup_writes=gain_writes(config), health=health)
     finally:
         if recorder is not None:
@@ -154,6 +162,19 @@ def _drive(args, config, source, commands_out) -> int:
     if sys.stderr.isatty():
         print(file=sys.stderr)
     return _report(args, config, frames, result, signals.first, sim)
+
+
+def _on_frame(view, frames: DriveFrames, health: HealthMonitor, clock):
+    """The status line, and the view's telemetry when --mcap or --foxglove is on."""
+    status = _status_line(frames, health)
+    return status if view is None else view.attach(frames, health, not isinstance(clock, VirtualClock), status)
+
+
+def _from_zero(clock):
+    """The clock as the simulation follows it: from 0 now (the real clock counts from the machine's start, and
+    the physics, which starts at 0, would otherwise first simulate all that time)."""
+    start_s = clock.now()
+    return lambda: clock.now() - start_s
 
 
 def _sim_walk(args, config, frames: DriveFrames):

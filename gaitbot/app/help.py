@@ -84,7 +84,7 @@ COMMAND_HELP = {
          "gaitbot walk --distance 1.0 --dry-run --record run.jsonl",
          "gaitbot walk --sim --distance 0.5")),
     "drive": CommandHelp(
-        "drive the robot live from a keyboard, a gamepad, UDP or a commands file",
+        "drive the robot live from a keyboard, a gamepad, UDP, Foxglove or a commands file",
         "Plan each step from the latest velocity command while the robot walks, check every frame before it\n"
         "is sent, and stream it at the robot's frame rate (docs/driving.md). Ctrl-C stops stepping and\n"
         "stands; a second Ctrl-C hurries to the stop ramp.",

@@ -76,16 +76,10 @@ class WalkView:
             print(f"note: {note}", file=sys.stderr)
 
 
-def open_view(args, config, goals, planned=None, health=None, realtime: bool = True) -> WalkView | None:
-    """The view of ``args.mcap`` / ``args.foxglove`` for this walk, or None when neither was asked for;
-    ``realtime``: the walk runs on a real clock (a full telemetry queue then drops a frame, never waits)."""
-    mcap, foxglove = getattr(args, "mcap", None), getattr(args, "foxglove", None)
-    if mcap is None and foxglove is None:
-        return None
+def _open_sinks(mcap, foxglove):
+    """The asked-for sinks and, with --foxglove, the Teleop source over its server; one line if one cannot open."""
     from gaitbot.app.options import UsageError
     from gaitbot.view.live import ViewOptionError
-    from gaitbot.view.publisher import BackgroundPublisher, TelemetryPublisher
-    from gaitbot.view.walk_frames import PlannedFrames
 
     sinks, teleop = [], None
     try:
@@ -99,11 +93,88 @@ def open_view(args, config, goals, planned=None, health=None, realtime: bool = T
             print(f"foxglove: ws://{live.host}:{live.port} (open it in Foxglove: docs/live-view.md)", file=sys.stderr)
             sinks.append(live)
             teleop = TeleopSource(live.inbox)
-        publisher = BackgroundPublisher(TelemetryPublisher(config.body.geometry, sinks), lossless=not realtime)
+        from gaitbot.view.ros2_messages import import_ros2_cdr
+        import_ros2_cdr()  # the messages' library, missing: one line now rather than a traceback later
     except (ImportError, OSError, ViewOptionError) as exc:
         for sink in sinks:
             sink.close()
         raise UsageError(str(exc) if not isinstance(exc, OSError) else f"--mcap {mcap}: {exc.strerror or exc}") from None
+    return sinks, teleop
+
+
+def open_view(args, config, goals, planned=None, health=None, realtime: bool = True) -> WalkView | None:
+    """The view of ``args.mcap`` / ``args.foxglove`` for this walk, or None when neither was asked for;
+    ``realtime``: the walk runs on a real clock (a full telemetry queue then drops a frame, never waits)."""
+    mcap, foxglove = getattr(args, "mcap", None), getattr(args, "foxglove", None)
+    if mcap is None and foxglove is None:
+        return None
+    sinks, teleop = _open_sinks(mcap, foxglove)
+    from gaitbot.view.publisher import BackgroundPublisher, TelemetryPublisher
+    from gaitbot.view.walk_frames import PlannedFrames
+
+    publisher = BackgroundPublisher(TelemetryPublisher(config, sinks), lossless=not realtime)
     view = WalkView(publisher, PlannedFrames(config, goals, planned), teleop)
     view.health = health
     return view
+
+
+# --- drive ------------------------------------------------------------------------------------------------
+FOXGLOVE_INPUT = "foxglove"
+
+
+def drive_input(args) -> str:
+    """``drive --input``: as given; left out, the Teleop panel with --foxglove, else the keyboard."""
+    if args.input is None:
+        args.input = FOXGLOVE_INPUT if getattr(args, "foxglove", None) is not None else "keyboard"
+    if args.input == FOXGLOVE_INPUT and getattr(args, "foxglove", None) is None:
+        args.foxglove = host_port(DEFAULT_FOXGLOVE)  # the Teleop panel needs the server
+    return args.input
+
+
+class DriveView:
+    """The sinks of one drive and, with --foxglove, its Teleop source; ``attach`` starts the telemetry once
+    the drive's frames exist (gaitbot.view.drive_telemetry does the work off the loop)."""
+
+    def __init__(self, config, sinks, teleop) -> None:
+        self.config, self.sinks, self.teleop = config, sinks, teleop
+        self.publisher = None
+
+    def attach(self, frames, health, realtime: bool, on_frame=None):
+        """A session ``on_frame(k, stats)`` callback feeding the view from ``frames`` (gaitbot.drive.frames),
+        then calling ``on_frame``; ``realtime`` as open_view's."""
+        import math
+
+        from gaitbot.view.drive_telemetry import DriveSample, DriveTelemetry
+        from gaitbot.view.publisher import BackgroundPublisher, TelemetryPublisher
+        from gaitbot.view.telemetry import health_of
+
+        telemetry = DriveTelemetry(self.config, TelemetryPublisher(self.config, self.sinks))
+        self.publisher = publisher = BackgroundPublisher(telemetry, lossless=not realtime)
+        self.sinks = []
+
+        def both(k: int, stats) -> None:
+            ticks, body, root, yaw = frames.body_pose()
+            c = frames.command
+            publisher.on_frame(DriveSample(frames.k * frames.period_s, ticks.copy(), body.copy(), root, yaw,
+                                           (c.vx_m_s, c.vy_m_s, math.radians(c.wz_deg_s)), health_of(health)))
+            if on_frame is not None:
+                on_frame(k, stats)
+        return both
+
+    def close(self) -> None:
+        for sink in self.sinks:  # never attached: a drive that ended before its first frame
+            sink.close()
+        self.sinks = []
+        if self.publisher is not None:
+            self.publisher.close()
+            for note in self.publisher.notes:
+                print(f"note: {note}", file=sys.stderr)
+            self.publisher = None
+
+
+def open_drive_view(args, config) -> DriveView | None:
+    """The view of ``drive --mcap/--foxglove`` (None when neither was asked for); call ``drive_input`` first."""
+    mcap, foxglove = getattr(args, "mcap", None), getattr(args, "foxglove", None)
+    if mcap is None and foxglove is None:
+        return None
+    return DriveView(config, *_open_sinks(mcap, foxglove))

@@ -102,6 +102,7 @@ class DriveFrames:
         self._origin = None
         self._sent: list[np.ndarray] = [self.stand, self.stand]
         self._ramp: list[np.ndarray] | None = None
+        self._body = None  # the walker's frame last handed out (None: standing or ramping), for body_pose
         self._new_walker()
         self.top, self.bottom = command_limits(config.steer, self._planner.step_s)
         self.start_root_m = tuple(float(v) for v in self._walker.rise_path[0][0])
@@ -142,9 +143,12 @@ class DriveFrames:
         if reason is not None:
             self._refuse(f"frame at {t_s:.2f} s refused: {reason}")
             return self._from_ramp()
-        return self._hand_out(self.config.calibration.angles_to_ticks(frame[2], LEG_JOINTS))
+        ticks = self._hand_out(self.config.calibration.angles_to_ticks(frame[2], LEG_JOINTS))
+        self._body = frame
+        return ticks
 
     def _hand_out(self, ticks: np.ndarray) -> np.ndarray:
+        self._body = None
         self._sent = [self._sent[1], ticks]
         self.k += 1
         return ticks
@@ -249,6 +253,20 @@ class DriveFrames:
         c, s = math.cos(self.log.heading_rad), math.sin(self.log.heading_rad)
         return (self.log.x_m + c * dx - s * dy, self.log.y_m + s * dx + c * dy,
                 self.log.heading_rad + here.yaw_rad - origin.yaw_rad)
+
+    def body_pose(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """The frame last handed out, for the view (gaitbot.view.drive_telemetry): its ticks, the planned body
+        angles (LEG_JOINTS, rad; 0 while standing or ramping), the root (m) and the torso's yaw (rad), both
+        in the drive's frame (the odometry composed as in walk_pose)."""
+        if self._body is None:
+            q, root, yaw = np.zeros(len(LEG_JOINTS)), self._walker.rise_path[0][0], 0.0
+        else:
+            q, root, yaw = self._body[1], self._body[3], self._walker.last_torso_yaw_rad()
+        origin, heading = self._origin, self.log.heading_rad
+        c, s = math.cos(heading), math.sin(heading)
+        dx, dy = root[0] - origin.x_m, root[1] - origin.y_m
+        world = np.array([self.log.x_m + c * dx - s * dy, self.log.y_m + s * dx + c * dy, root[2]])
+        return self._sent[1], q, world, heading + yaw - origin.yaw_rad
 
     def _refuse(self, reason: str) -> None:
         if self.log.refused is None:

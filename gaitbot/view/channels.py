@@ -9,9 +9,7 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
-from gaitbot.view.link_frames import WORLD_FRAME, LinkTransforms, quaternion_rpy
+from gaitbot.view.link_frames import WORLD_FRAME, LinkTransforms, rotation_xyzw
 from gaitbot.view.telemetry import FrameTelemetry
 
 CHANNELS = {
@@ -27,8 +25,14 @@ CHANNELS = {
     "/support_polygon": "geometry_msgs/msg/PolygonStamped",
     "/footprints": "geometry_msgs/msg/PoseArray",
     "/diagnostics": "diagnostic_msgs/msg/DiagnosticArray",
+    "/tf_static": "tf2_msgs/msg/TFMessage",
+    "/robot_description": "std_msgs/msg/String",
 }
 """Topic -> ROS 2 message type, every channel the view can write."""
+
+STATIC_CHANNELS = ("/tf_static", "/robot_description")
+"""Written once at the start of a log, and again every few seconds to a live server (a client that connects
+later gets them too): the fixed frames, and the URDF the 3D panel draws (``gaitbot robot export --urdf``)."""
 
 IMU_FRAME = "imu_link"
 _UNKNOWN_COVARIANCE = [-1.0] + [0.0] * 8  # sensor_msgs/Imu: element 0 = -1 means "no estimate"
@@ -53,21 +57,6 @@ def joint_state(stamp_ns: int, joints, angles_rad) -> dict:
             "velocity": [], "effort": []}
 
 
-def rotation_xyzw(rotation: np.ndarray) -> tuple[float, float, float, float]:
-    """The unit quaternion of a rotation matrix (Shepperd's method: the largest diagonal term first)."""
-    m = rotation
-    trace = m[0, 0] + m[1, 1] + m[2, 2]
-    if trace > 0:
-        s = 2.0 * math.sqrt(1.0 + trace)
-        return ((m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, s / 4)
-    i = int(np.argmax([m[0, 0], m[1, 1], m[2, 2]]))
-    j, k = (i + 1) % 3, (i + 2) % 3
-    s = 2.0 * math.sqrt(1.0 + m[i, i] - m[j, j] - m[k, k])
-    q = [0.0, 0.0, 0.0, (m[k, j] - m[j, k]) / s]
-    q[i], q[j], q[k] = s / 4, (m[j, i] + m[i, j]) / s, (m[k, i] + m[i, k]) / s
-    return tuple(float(v) for v in q)
-
-
 def _diagnostics(stamp_ns: int, health) -> dict:
     values = [(key, value) for key, value in (("hottest_c", health.hottest_c), ("lowest_voltage_v", health.lowest_voltage_v),
                                               ("peak_load_pct", health.peak_load_pct)) if value is not None]
@@ -85,15 +74,24 @@ def _imu(stamp_ns: int, imu) -> dict:
             "linear_acceleration": _xyz(imu.linear_acceleration_m_s2), "linear_acceleration_covariance": [0.0] * 9}
 
 
+def _transform(stamp_ns: int, t) -> dict:
+    return {"header": header(stamp_ns, t.parent), "child_frame_id": t.child,
+            "transform": {"translation": _xyz(t.translation), "rotation": _quaternion(t.rotation_xyzw)}}
+
+
+def static_messages(stamp_ns: int, links: LinkTransforms, urdf: str) -> list[tuple[str, dict]]:
+    """(topic, message) of the STATIC_CHANNELS: every fixed joint's transform, and the robot's URDF."""
+    return [("/tf_static", {"transforms": [_transform(stamp_ns, t) for t in links.static]}),
+            ("/robot_description", {"data": urdf})]
+
+
 def frame_messages(frame: FrameTelemetry, stamp_ns: int, links: LinkTransforms) -> list[tuple[str, dict]]:
     """(topic, message) of every channel that has data this frame (messages as nested dicts)."""
     out = [("/joint_goals", joint_state(stamp_ns, frame.joints, frame.goals_rad))]
     if frame.read_back_rad is not None:
         out.append(("/joint_states", joint_state(stamp_ns, frame.joints, frame.read_back_rad)))
-    out.append(("/tf", {"transforms": [
-        {"header": header(stamp_ns, t.parent), "child_frame_id": t.child,
-         "transform": {"translation": _xyz(t.translation), "rotation": _quaternion(t.rotation_xyzw)}}
-        for t in links.transforms(frame.joints, frame.goals_rad, frame.root_m, frame.root_rpy_rad)]}))
+    out.append(("/tf", {"transforms": [_transform(stamp_ns, t) for t in links.transforms(
+        frame.joints, frame.goals_rad, frame.root_m, frame.root_rpy_rad)]}))
     if frame.command is not None:
         vx, vy, wz = frame.command
         out.append(("/walk_command", {"linear": _xyz((vx, vy, 0.0)), "angular": _xyz((0.0, 0.0, wz))}))

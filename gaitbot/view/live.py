@@ -71,6 +71,7 @@ class FoxgloveSink:
         self.label = f"--foxglove {host}:{self.port}"
         self._channels: dict = {}
         self.closing_note = ""
+        self.repeats_static = True  # a client may connect at any time: /tf_static and /robot_description again
 
     def channel(self, topic: str, type_name: str):
         channel = self._channels.get(topic)

@@ -15,21 +15,28 @@ import queue
 import threading
 import time
 
-from gaitbot.gait.body import BodyGeometry
-from gaitbot.view.channels import CHANNELS, frame_messages
+from gaitbot.robot.config import RobotConfig
+from gaitbot.robot.description.urdf_writer import urdf_text
+from gaitbot.view.channels import CHANNELS, frame_messages, static_messages
 from gaitbot.view.link_frames import LinkTransforms
 from gaitbot.view.ros2_messages import encoder
 from gaitbot.view.telemetry import FrameTelemetry
+
+STATIC_EVERY_S = 2.0  # how often a live server gets the static channels again
 
 
 class TelemetryPublisher:
     """A :class:`~gaitbot.view.telemetry.Telemetry` observer writing every channel to every sink.
 
     ``start_ns``: the wall-clock time (ns since the Unix epoch) of the walk's t = 0, so that logs and live
-    messages carry real stamps (default: now)."""
+    messages carry real stamps (default: now). The static channels (gaitbot.view.channels.STATIC_CHANNELS)
+    go to every sink with the first frame, and again every ``STATIC_EVERY_S`` to a sink whose
+    ``repeats_static`` is true (a live server: a client may connect at any time)."""
 
-    def __init__(self, geometry: BodyGeometry, sinks, start_ns: int | None = None) -> None:
-        self.links = LinkTransforms(geometry)
+    def __init__(self, config: RobotConfig, sinks, start_ns: int | None = None) -> None:
+        self.links = LinkTransforms(config)
+        self.urdf = urdf_text(config)
+        self._static_due_s = 0.0
         self.sinks = list(sinks)
         self.start_ns = time.time_ns() if start_ns is None else int(start_ns)
         self.encoders = {name: encoder(name) for name in set(CHANNELS.values())}  # built before the first frame
@@ -40,10 +47,17 @@ class TelemetryPublisher:
         if not self.sinks:
             return
         stamp_ns = self.start_ns + round(frame.t_s * 1e9)
-        for topic, message in frame_messages(frame, stamp_ns, self.links):
+        messages = frame_messages(frame, stamp_ns, self.links)
+        if self.frames == 0 or frame.t_s >= self._static_due_s:
+            first = self.frames == 0
+            self._static_due_s = frame.t_s + STATIC_EVERY_S
+            messages += [(topic, message, first) for topic, message in static_messages(stamp_ns, self.links, self.urdf)]
+        for topic, message, *first in messages:
             type_name = CHANNELS[topic]
             data = self.encoders[type_name](message)
-            for sink in list(self.sinks):
+            sinks = (self.sinks if not first or first[0]
+                     else [s for s in self.sinks if getattr(s, "repeats_static", False)])
+            for sink in list(sinks):
                 try:
                     sink.write(topic, type_name, data, stamp_ns)
                 except Exception as exc:  # noqa: BLE001 - a log or a viewer must never stop the walk

@@ -42,6 +42,7 @@ DEFINITIONS = {
     "geometry_msgs/msg/PolygonStamped": "std_msgs/Header header\ngeometry_msgs/Polygon polygon",
     "geometry_msgs/msg/PoseArray": "std_msgs/Header header\ngeometry_msgs/Pose[] poses",
     "diagnostic_msgs/msg/DiagnosticArray": "std_msgs/Header header\ndiagnostic_msgs/DiagnosticStatus[] status",
+    "std_msgs/msg/String": "string data",
 }
 _SEPARATOR = "=" * 80
 

@@ -83,7 +83,7 @@ async def session(url: str, publisher, teleop: TeleopSource) -> dict:
 
 def test_a_foxglove_client_sees_joints_and_transforms_and_steers():
     sink = FoxgloveSink("127.0.0.1", 0)
-    publisher = TelemetryPublisher(config("op3").body.geometry, [sink])
+    publisher = TelemetryPublisher(config("op3"), [sink])
     teleop = TeleopSource(sink.inbox)
     try:
         got = asyncio.run(asyncio.wait_for(session(f"ws://127.0.0.1:{sink.port}", publisher, teleop), 4 * BOUND_S))

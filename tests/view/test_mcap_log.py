@@ -13,11 +13,11 @@ from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 
 from gaitbot.gait.joints import LEG_JOINTS  # noqa: E402
 from gaitbot.robot.calibration import angles_to_ticks  # noqa: E402
-from gaitbot.view.channels import CHANNELS  # noqa: E402
+from gaitbot.view.channels import CHANNELS, STATIC_CHANNELS  # noqa: E402
 from gaitbot.view.mcap_log import McapSink  # noqa: E402
 from gaitbot.view.publisher import TelemetryPublisher  # noqa: E402
 from gaitbot.view.telemetry import FrameTelemetry, ImuSample, ServoHealth  # noqa: E402
-from helpers import config, goal_line_indices, read_lines, run_cli, split_sync_write  # noqa: E402
+from helpers import config, recorded_goal_ticks, run_cli  # noqa: E402
 
 START_NS = 1_700_000_000_000_000_000
 
@@ -51,14 +51,15 @@ def random_frames(n: int, rng) -> list[FrameTelemetry]:
 
 def test_every_channel_every_frame_decodes_to_what_was_sent(tmp_path):
     frames = random_frames(30, np.random.default_rng(24))
-    publisher = TelemetryPublisher(config("op3").body.geometry, [McapSink(tmp_path / "w.mcap")], start_ns=START_NS)
+    publisher = TelemetryPublisher(config("op3"), [McapSink(tmp_path / "w.mcap")], start_ns=START_NS)
     for frame in frames:
         publisher.on_frame(frame)
     publisher.close()
     log = read_back(tmp_path / "w.mcap")
     assert set(log) == set(CHANNELS)
     for topic, messages in log.items():
-        assert [t for t, *_ in messages] == [START_NS + round(k * 1e9 / 60) for k in range(30)], topic
+        times = [START_NS] if topic in STATIC_CHANNELS else [START_NS + round(k * 1e9 / 60) for k in range(30)]
+        assert [t for t, *_ in messages] == times, topic  # the static ones once, at the start
         assert {(s, e) for _, s, e, _ in messages} == {(CHANNELS[topic], "cdr")}
     for frame, (_, _, _, goals), (_, _, _, states), (_, _, _, com), (_, _, _, zmp), (_, _, _, twist), (_, _, _, imu), \
             (_, _, _, polygon), (_, _, _, diag) in zip(frames, log["/joint_goals"], log["/joint_states"], log["/com"],
@@ -86,22 +87,65 @@ def test_walk_mcap_holds_every_channel_at_the_frame_rate_and_the_goals_the_servo
     walk_frames = int(out.split("Sent ")[1].split()[0])
     log = read_back(mcap)
     expected = {"/joint_goals", "/tf", "/com", "/zmp", "/support_polygon", "/footprints", "/diagnostics"}
-    assert set(log) == expected  # a dry run has no read-back, IMU or command
+    assert set(log) == expected | set(STATIC_CHANNELS)  # a dry run has no read-back, IMU or command
     for topic in expected:
         times = np.array([t for t, *_ in log[topic]])
         assert len(times) == walk_frames, topic
         assert np.allclose(np.diff(times), 1e9 / 60, atol=1), topic
     # the goals logged, turned into ticks, are the goal packets the mock bus recorded, frame for frame
     cfg = config("op3")
-    rows = read_lines(record)
-    sent = []
-    for k in goal_line_indices(rows, "op3"):
-        _, length, entries = split_sync_write(rows[0], bytes.fromhex(rows[k]["hex"]))
-        ticks = dict((i, int.from_bytes(d, "little")) for i, d in entries)
-        sent.append([ticks[j.id] for j in cfg.joints])
+    sent = recorded_goal_ticks(record, "op3", cfg.joints)
     logged = [list(angles_to_ticks(cfg, np.array(m.position), m.name)) for *_, m in log["/joint_goals"]]
     start = sent.index(logged[1]) - 1
     assert sent[start:start + len(logged)] == logged
     # /tf: the pelvis walks the planned distance
     x = [m.transforms[0].transform.translation.x for *_, m in log["/tf"]]
     assert x[-1] - x[0] == pytest.approx(0.1, abs=0.01)
+
+
+def test_the_log_carries_the_exported_urdf_and_its_fixed_frames(tmp_path, capsys):
+    """/robot_description is the file ``gaitbot robot export --urdf`` writes, and /tf_static holds every fixed
+    joint of it with the origin it gives (so Foxglove's 3D panel draws the robot from the log alone)."""
+    import xml.etree.ElementTree as ET
+
+    mcap, urdf = tmp_path / "walk.mcap", tmp_path / "op3.urdf"
+    assert run_cli(capsys, "robot", "export", "op3", "--urdf", urdf)[0] == 0
+    code, _, err = run_cli(capsys, "walk", "--robot", "op3", "--dry-run", "--distance", "0.05", "--mcap", mcap)
+    assert code == 0, err
+    log = read_back(mcap)
+    (_, _, _, description), = log["/robot_description"]
+    assert description.data == urdf.read_text()
+    (_, _, _, static), = log["/tf_static"]
+    fixed = {j.get("name"): j for j in ET.parse(urdf).getroot().iter("joint") if j.get("type") == "fixed"}
+    assert len(static.transforms) == len(fixed)
+    by_child = {t.child_frame_id: t for t in static.transforms}
+    for joint in fixed.values():
+        t = by_child[joint.find("child").get("link")]
+        assert t.header.frame_id == joint.find("parent").get("link")
+        xyz = [float(v) for v in joint.find("origin").get("xyz").split()]
+        assert np.allclose([t.transform.translation.x, t.transform.translation.y, t.transform.translation.z], xyz,
+                           atol=1e-12)
+
+
+def test_static_channels_once_in_a_log_and_every_few_seconds_live():
+    """A client may connect to the live server at any time: it must get the URDF and the fixed frames too."""
+    from gaitbot.view.publisher import STATIC_EVERY_S
+
+    class Sink:
+        def __init__(self, repeats: bool) -> None:
+            self.repeats_static, self.times = repeats, []
+            self.label, self.closing_note = "sink", ""
+
+        def write(self, topic, type_name, data, log_time_ns) -> None:
+            if topic == "/robot_description":
+                self.times.append((log_time_ns - START_NS) / 1e9)
+
+        def close(self) -> None:
+            pass
+
+    log, live = Sink(False), Sink(True)
+    publisher = TelemetryPublisher(config("op3"), [log, live], start_ns=START_NS)
+    for frame in random_frames(300, np.random.default_rng(1)):  # 5 s at 60 Hz
+        publisher.on_frame(frame)
+    assert log.times == [0.0]
+    assert live.times == pytest.approx([k * STATIC_EVERY_S for k in range(int(5 / STATIC_EVERY_S) + 1)], abs=1 / 60)

@@ -321,6 +321,11 @@ class BalancedWalker(Lookahead):
             stores += [len(self._err), len(self._pts), len(self._s1_com), len(self._s1_snapshot)]
         return max(stores)
 
+    def last_torso_yaw_rad(self) -> float:
+        """The torso's yaw (rad, the walker's world) in the frame ``next_frame`` gave last: the mean of the
+        feet's yaws at that plan frame (while rising: the first; while lowering: the last). For the view."""
+        return float(torso_yaw(self._ext_at("yaw", max(self._k - 1, 0))))
+
     def _ext_at(self, name: str, j: int):
         a = self._ext[name]
         return a[min(j - self._base, len(a) - 1)]
