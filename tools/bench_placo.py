@@ -1,4 +1,4 @@
-"""gaitbot's balanced walk beside Rhoban's PlaCo (docs/benchmarks.md, "Beside PlaCo"). Run: python tools/bench_placo.py
+"""gaitbot's balanced walk beside Rhoban's PlaCo (docs/placo.md). Run: python tools/bench_placo.py
 
 The same robot: the URDF ``gaitbot robot export op3 --urdf`` writes (PlaCo's HumanoidRobot reads its
 ``trunk``, ``left_foot`` and ``right_foot`` frames). The same footsteps and timing: gaitbot's footstep
