@@ -71,7 +71,8 @@ def add_parser(subparsers):
     p = add_command(subparsers, "walk")
     walk_options(p, demo=True)
     p.add_argument("--trajectory", metavar="FILE", help="walk a trajectory file (.csv/.npz: gaitbot generate, "
-                   "eigen synth, record) instead of --steps/--distance; it streams at its own frame rate")
+                   "eigen synth, record) instead of --steps/--distance; it streams at its own frame rate, on the "
+                   "robot it was made for unless --robot says (the same one)")
     bus_options(p, "use the mock bus under the real SDK: no hardware, and every packet exactly as a real walk sends it")
     p.add_argument("--realtime", action="store_true",
                    help="--dry-run: pace it at the real frame rate (default: a simulated clock, as fast as it goes)")
