@@ -211,3 +211,24 @@ def test_a_bad_calibration_header_is_one_line(capsys, tmp_path, sent, field):
     run.write_text("\n".join([json.dumps(header)] + lines[1:]) + "\n")
     err = one_line_exit_2(run_cli(capsys, "check", run))
     assert "header calibration" in err and field in err
+
+
+HOSTILE = [None, True, "", "x" * 300, -1, 10**400, 1e308, float("nan"), [], [[1, 2, 3, 4]], [[0, 1, float("inf")]],
+           {}, {"a": 1}, [[True, 1, 0]], [[0, 1, 0]] * 101, "a\nb"]
+
+
+@pytest.mark.parametrize("key", ["robot", "robot_config", "robot_geometry", "terrain", "treads"])
+def test_hostile_origin_values_are_read_or_refused_in_one_line(files, tmp_path, key):
+    """Every value of every field: the file loads (the value was acceptable) or TrajectoryFileError names it."""
+    from gaitbot.gait.trajectory import Trajectory, TrajectoryFileError, read_origin
+
+    rows = files["op3.csv"].read_text().split("\n", 1)[1]
+    for value in HOSTILE:
+        path = tmp_path / "h.csv"
+        path.write_text("# gaitbot trajectory 2 origin: " + json.dumps({key: value}) + "\n" + rows)
+        try:
+            origin = Trajectory.load(path).origin
+        except TrajectoryFileError as exc:
+            assert str(path) in str(exc) and "\n" not in str(exc)
+            continue
+        assert origin == read_origin(path) and (value is None or getattr(origin, key) is not None)
