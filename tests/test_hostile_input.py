@@ -158,7 +158,7 @@ def jsonl_mutation(draw, text: str) -> str:
     how = draw(st.sampled_from(["header", "header", "packet", "line", "truncate", "deep"]))
     if how == "header":
         header = json.loads(lines[0])
-        header[draw(st.sampled_from(sorted(header) + ["rate_hz"]))] = draw(st.sampled_from(HOSTILE_JSON))
+        header[draw(st.sampled_from(sorted(header) + ["rate_hz", "calibration"]))] = draw(st.sampled_from(HOSTILE_JSON))
         lines[0] = json.dumps(header)
     elif how == "packet":
         row = draw(st.integers(1, len(lines) - 1))

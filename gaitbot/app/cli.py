@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import signal
 import sys
 import warnings
@@ -33,9 +34,20 @@ COMMANDS = {name: f"gaitbot.app.{name}" for name in ("plan", "generate", "plot",
 EXIT_BROKEN_PIPE = 141
 
 
+#: A value that is a number or a comma-separated list of numbers, negative ones included (``-0.05,-0.05``,
+#: ``-0.1,0,15``, ``-1e-3``): argparse takes only a lone negative number for a value, and anything else
+#: starting with "-" for an option ("expected one argument"). No gaitbot option looks like a number.
+NUMBERS = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(,\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)*$")
+
+
 class OneLineParser(argparse.ArgumentParser):
     """argparse, but a usage error is one line (the program, the error, where to look) and exit 2: no usage
-    block around it (``--help`` still prints the usage). Subcommands' parsers are of the same class."""
+    block around it (``--help`` still prints the usage); a list of numbers that starts with a negative one is
+    a value (NUMBERS). Subcommands' parsers are of the same class."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NUMBERS  # argparse's own hook (tests/app: negative step lists)
 
     def error(self, message: str):  # noqa: D401 - argparse's name
         self.exit(2, f"{self.prog}: error: {' '.join(message.split())} (see {self.prog} --help)\n")

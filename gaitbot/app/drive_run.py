@@ -25,6 +25,7 @@ from gaitbot.drive.frames import DriveFrames, command_limits
 from gaitbot.errors import UserError
 from gaitbot.inputs.open import open_source
 from gaitbot.robot.calibration import standing_ticks
+from gaitbot.robot.calibration_file import sent_calibration
 from gaitbot.robot.gains import gain_writes
 from gaitbot.robot.steered_walk import footstep_planner
 from gaitbot.robot.walk_settings import joint_limits_ticks
@@ -140,7 +141,7 @@ def _drive(args, config, source, commands_out, view=None) -> int:
     recorder = None
     if args.record:
         recorder = BusRecorder(args.record, robot=config.name, joints={j.name: j.id for j in config.joints},
-                               clock=clock.now, rate_hz=1.0 / frames.period_s)
+                               clock=clock.now, rate_hz=1.0 / frames.period_s, calibration=sent_calibration(config))
     try:
         bus = (guarded(config, sim.make_bus(_from_zero(clock), recorder)) if sim is not None else
                make_robot_bus(config, port, dry_run=args.dry_run, recorder=recorder,

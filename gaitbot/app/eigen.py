@@ -25,6 +25,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -41,6 +42,7 @@ from gaitbot.app.planned_walk import balanced_plan
 from gaitbot.check.preflight import preflight
 from gaitbot.errors import UserError
 from gaitbot.robot.config import shipped_config_names
+from gaitbot.robot.origin import origin_for
 from gaitbot.robot.walk_settings import GaitSource, walk_settings
 
 POSE_TOL_DEG = 0.1
@@ -396,6 +398,7 @@ def run_synth(args) -> int:
             raise
         raise UsageError(f"{args.model}: this model does not synthesise a walk of finite angles "
                          f"({' '.join(str(exc).split())}); fit it again with `gaitbot eigen fit`") from None
+    walk = replace(walk, origin=origin_for(config))  # the file remembers its robot
     write_output(out, walk.save)
     xs = [h.x_m for h in walk.heel_strikes]
     # the last heel strike is the walker's closing step: the trailing foot set down beside the leading one

@@ -161,11 +161,22 @@ COMMAND_HELP = {
         ("gaitbot calibrate --robot robots/mybot.toml -o robots/mybot.calibration.toml",
          "gaitbot walk --robot robots/mybot.toml --calibration robots/mybot.calibration.toml --distance 0.5")),
     "robot": CommandHelp(
-        "a robot config to and from URDF and MJCF (the field's robot descriptions)",
-        "Export a robot config as URDF or MJCF for the tools the field looks at robots with (RViz, Foxglove,\n"
-        "MuJoCo's viewer, PlaCo), or import a robot's URDF or MJCF as a config draft (docs/robot-description.md).",
-        ("gaitbot robot export op3 --urdf op3.urdf --mjcf op3.xml",
+        "a new robot config, or a robot config to and from URDF and MJCF (the field's robot descriptions)",
+        "Start a new robot from a complete commented template (robot new), export a robot config as URDF or\n"
+        "MJCF for the tools the field looks at robots with (RViz, Foxglove, MuJoCo's viewer, PlaCo), or import a\n"
+        "robot's URDF or MJCF as a config draft (docs/robot-description.md).",
+        ("gaitbot robot new mybot --legs 12 -o mybot.toml",
+         "gaitbot robot export op3 --urdf op3.urdf --mjcf op3.xml",
          "gaitbot robot import op3.urdf --like config/op3.toml -o mine.toml")),
+    "robot new": CommandHelp(
+        "write a new robot's config: a complete commented template that walks as it is",
+        "A made-up robot of the usual size (220 mm legs, Dynamixel X servos) with 6 joints (hip, knee and ankle\n"
+        "pitch: it walks on a boom) or 12 (hip yaw, roll, pitch, knee, ankle pitch, roll: it balances). It plans,\n"
+        "generates, checks and simulates as it is; every value only your robot can give is marked FILL IN, and\n"
+        "[robot] draft keeps the hardware commands from using it until you delete that line (docs/robot-config.md).",
+        ("gaitbot robot new mybot --legs 12 -o mybot.toml",
+         "gaitbot generate --robot mybot.toml --distance 0.3 -o mybot-walk.csv",
+         "gaitbot check mybot-walk.csv")),
     "robot export": CommandHelp(
         "write a robot config as URDF and/or MJCF",
         "Links, joints (axes, the config's limits), masses, centres of mass and inertias, the feet as boxes,\n"

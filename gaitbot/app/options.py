@@ -181,7 +181,8 @@ def step_lengths(args, source: GaitSource) -> list[float]:
         steps = steps_for_distance(distance, max_step)
     for i, value in enumerate(steps, start=1):
         if value < 0:
-            raise UsageError(f"--steps: step {i} is {value:g} m; step lengths must be 0 or more")
+            raise UsageError(f"--steps: step {i} is {value:g} m; step lengths must be 0 or more (a robot whose legs "
+                             f"roll walks backwards when steered: --velocity -0.02,0,0 --duration S)")
         if value > source.max_step_m * (1 + 1e-12):
             what = ("max_step_m in the robot config" if source.robot is not None and not source.balanced
                     else "the leg's reachable maximum")

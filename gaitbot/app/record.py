@@ -32,6 +32,7 @@ from gaitbot.gait.trajectory import CsvTrajectoryWriter
 from gaitbot.robot.calibration import ticks_to_angles
 from gaitbot.robot.config import RobotConfig
 from gaitbot.robot.gains import gain_notes, gain_writes
+from gaitbot.robot.origin import origin_for
 from gaitbot.robot.walk_settings import leg_geometry
 from gaitbot.stream.clock import MonotonicClock, VirtualClock
 from gaitbot.stream.health import HealthMonitor
@@ -83,7 +84,8 @@ class TrajectorySink:
         self._pitch_columns = [names.index(n) for n in PITCH_JOINTS]  # the contact model's legs
 
     def open(self) -> None:
-        self.writer = CsvTrajectoryWriter(self.path, self.config.walking_joint_names)
+        self.writer = CsvTrajectoryWriter(self.path, self.config.walking_joint_names,
+                                          origin_for(self.config, ground_known=False))  # the ground is not known
         self.root = ContactRoot(leg_geometry(self.config))
 
     def add(self, t_s: float, ticks: np.ndarray) -> None:

@@ -1,4 +1,5 @@
-"""``gaitbot robot export`` and ``gaitbot robot import``: a robot config to and from URDF and MJCF.
+"""``gaitbot robot new``, ``export`` and ``import``: a new robot's config from a template, a robot config to
+and from URDF and MJCF.
 
 The parser lives here (``add_parser``: the command line registers it in one line); the work is the robot
 room's (gaitbot.robot.description: the URDF writer, the chain finder, the importer, the draft) and the sim
@@ -21,8 +22,15 @@ def add_parser(sub) -> argparse.ArgumentParser:
     sub-commands' parsers by name (their errors print their own usage)."""
     command = add_command
     p = command(sub, "robot")
-    robot = p.add_subparsers(dest="robot_command", required=True, metavar="{export,import}",
-                             help="export a config to URDF/MJCF, or import a URDF/MJCF as a config draft")
+    robot = p.add_subparsers(dest="robot_command", required=True, metavar="{new,export,import}",
+                             help="start a new robot's config, export a config to URDF/MJCF, or import a URDF/MJCF "
+                                  "as a config draft")
+    n = command(robot, "robot new")
+    n.add_argument("name", help="the robot's name ([robot] name), e.g. mybot")
+    n.add_argument("--legs", type=int, required=True, choices=(6, 12), metavar="{6,12}",
+                   help="joints in both legs: 6 (hip, knee, ankle pitch; walks on a boom) or 12 (also hip yaw and "
+                        "roll, ankle roll; balances)")
+    n.add_argument("-o", "--output", required=True, metavar="FILE", help="the config to write (.toml)")
     e = command(robot, "robot export")
     e.add_argument("robot", help="robot config: a .toml path or a shipped name (e.g. op3)")
     e.add_argument("--urdf", metavar="FILE", help="write the robot as URDF to FILE")
@@ -34,12 +42,36 @@ def add_parser(sub) -> argparse.ArgumentParser:
                    "gait settings from this config, by joint name (default: placeholders, marked as a draft)")
     i.add_argument("--map", metavar="FILE", help="which description joint is which gaitbot joint, when the names do "
                    "not say: a [joints] table, gaitbot joint = \"description joint\" (a leading - flips the sign)")
-    p.commands = {"robot export": e, "robot import": i}
+    p.commands = {"robot new": n, "robot export": e, "robot import": i}
     return p
 
 
 def run(args) -> int:
-    return export(args) if args.robot_command == "export" else import_description(args)
+    return {"new": new, "export": export, "import": import_description}[args.robot_command](args)
+
+
+def new(args) -> int:
+    from gaitbot.app.options import UsageError, file_option
+    from gaitbot.app.outputs import output_path, write_output
+    from gaitbot.robot.config import ConfigError, load_robot_config
+    from gaitbot.robot.template import template_text
+
+    out = Path(file_option(args.output, "-o"))
+    if out.suffix != ".toml":
+        raise UsageError(f"-o {out}: a robot config's name ends in .toml")
+    name = args.name.strip()
+    if not name or len(name) > 64 or not all(c.isalnum() or c in "-_." for c in name):
+        raise UsageError(f"name {args.name!r}: 1..64 letters, digits, '-', '_' or '.'")
+    output_path(out, "-o", args)
+    write_output(out, lambda path: path.write_text(template_text(name, args.legs, str(out))))
+    try:
+        config = load_robot_config(out)  # the template loads as written, or nothing is left behind
+    except ConfigError as exc:
+        out.unlink(missing_ok=True)
+        raise UsageError(f"the template would not load ({exc}); nothing written") from None
+    print(f"wrote {out}: {config.name}, {len(config.joints)} joints, a draft: fill in what is marked FILL IN, "
+          f"then delete the [robot] draft line (docs/robot-config.md)")
+    return 0
 
 
 def export(args) -> int:

@@ -13,7 +13,8 @@ import sys
 from gaitbot.app.arguments import add_command, bus_options, check_walk_source, walk_options
 from gaitbot.app.feel_options import add_feedback_option, fall_dict, fall_line, feedback_mode, make_feedback
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
-from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
+from gaitbot.app.file_robot import robot_for_walk
+from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option
 from gaitbot.app.planned_walk import PlannedWalk, planned_walk
 from gaitbot.app.outputs import output_path
 from gaitbot.app.progress import callback, progress
@@ -24,6 +25,7 @@ from gaitbot.bus.recording import BusRecorder, RecordingFailed
 from gaitbot.check.preflight import preflight
 from gaitbot.errors import UserError
 from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
+from gaitbot.robot.calibration_file import sent_calibration
 from gaitbot.robot.gains import gain_notes, gain_writes
 from gaitbot.robot.walk_settings import joint_limits_ticks
 from gaitbot.sim import import_mujoco
@@ -69,7 +71,8 @@ def add_parser(subparsers):
     p = add_command(subparsers, "walk")
     walk_options(p, demo=True)
     p.add_argument("--trajectory", metavar="FILE", help="walk a trajectory file (.csv/.npz: gaitbot generate, "
-                   "eigen synth, record) instead of --steps/--distance; it streams at its own frame rate")
+                   "eigen synth, record) instead of --steps/--distance; it streams at its own frame rate, on the "
+                   "robot it was made for unless --robot says (the same one)")
     bus_options(p, "use the mock bus under the real SDK: no hardware, and every packet exactly as a real walk sends it")
     p.add_argument("--realtime", action="store_true",
                    help="--dry-run: pace it at the real frame rate (default: a simulated clock, as fast as it goes)")
@@ -97,7 +100,7 @@ def run(args) -> int:
     check_sim_arguments(args)
     refuse_port_in_dry_run(args)
     check_reply_timeout(args.reply_timeout_ms)
-    config = load_robot(args.robot, getattr(args, "calibration", None))
+    config = robot_for_walk(args)
     check_rate_option(config, args.rate)
     walk = planned_walk(args, config)
     report = preflight(config, walk.goals, on_boom=args.boom, planned=walk.planned)
@@ -157,7 +160,8 @@ def _recorder(args, config, clock, rate_hz: float) -> BusRecorder | None:
         return None
     output_path(args.record, "--record", args)
     joints = {j.name: j.id for j in config.joints}
-    return BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now, rate_hz=rate_hz)
+    return BusRecorder(args.record, robot=config.name, joints=joints, clock=clock.now, rate_hz=rate_hz,
+                       calibration=sent_calibration(config))
 
 
 def _open_bus(args, config, port: str, sim, clock, recorder: BusRecorder | None):

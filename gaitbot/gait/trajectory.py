@@ -20,6 +20,8 @@ import numpy as np
 
 from gaitbot.errors import UserError
 from gaitbot.fields import read_user_file
+from gaitbot.gait.file_origin import (CSV_PREFIX, MAX_LINE_CHARS, ORIGIN_ARRAYS, FileOrigin, OriginProblem,
+                                      origin_from_csv_text, origin_from_npz)
 from gaitbot.gait.joints import LEG_JOINTS, PITCH_JOINTS, canonical, is_leg_joint
 from gaitbot.gait.npz_file import NpzProblem, numeric, read_npz
 
@@ -58,6 +60,7 @@ class Trajectory:
     heel_strikes: the planned heel-strike events, in time order.
     joints: the joint names of the columns of angles_rad (default: the planar walker's six).
     torso_rpy_rad: (N, 3) torso roll, pitch, yaw (radians) where the gait moves them; None: upright.
+    origin: the robot and terrain it was made for (gaitbot.gait.file_origin); None: not said.
     """
 
     t_s: np.ndarray
@@ -66,6 +69,7 @@ class Trajectory:
     heel_strikes: tuple[HeelStrike, ...] = field(default_factory=tuple)
     joints: tuple[str, ...] = PITCH_JOINTS
     torso_rpy_rad: np.ndarray | None = None
+    origin: FileOrigin | None = None
 
     def __post_init__(self) -> None:
         n = len(self.t_s)
@@ -127,11 +131,13 @@ class Trajectory:
             strikes = np.array([(h.t_s, 0 if h.leg == "left" else 1, h.x_m, np.nan if h.y_m is None else h.y_m)
                                 for h in self.heel_strikes], dtype=float).reshape(-1, 4)
             extra = {} if self.torso_rpy_rad is None else {"torso_rpy_deg": np.degrees(self.torso_rpy_rad)}
+            extra.update(self.origin.npz_arrays() if self.origin is not None else {})
             np.savez(path, format_version=np.array(FORMAT_VERSION), t_s=self.t_s, angles_deg=self.angles_deg,
                      root_m=self.root_m, heel_strikes=strikes, joints=np.array(self.joints), **extra)
         elif path.suffix == ".csv":
             with open(path, "w", newline="") as f:
-                f.write(VERSION_LINE + "\n" + ",".join(self.columns()) + "\n")
+                origin = "" if self.origin is None else self.origin.csv_suffix()
+                f.write(VERSION_LINE + origin + "\n" + ",".join(self.columns()) + "\n")
                 np.savetxt(f, self.table(), delimiter=",", fmt="%.9g")
         else:
             raise TrajectoryFileError(f"{path}: unknown trajectory format {path.suffix!r} (allowed: .csv, .npz)")
@@ -175,13 +181,15 @@ class CsvTrajectoryWriter:
     power cut. Same columns and number format as ``Trajectory.save``.
     """
 
-    def __init__(self, path: str | Path, joints: tuple[str, ...] = PITCH_JOINTS) -> None:
+    def __init__(self, path: str | Path, joints: tuple[str, ...] = PITCH_JOINTS,
+                 origin: FileOrigin | None = None) -> None:
         self.path = Path(path)
         self.joints = canonical(joints)
         self.rows = 0
-        self._file = open(self.path, "w", newline="", encoding="ascii")
+        self._file = open(self.path, "w", newline="", encoding="utf-8")
         header = ("t_s",) + tuple(f"{name}_deg" for name in self.joints) + ROOT_COLUMNS
-        self._file.write(VERSION_LINE + "\n" + ",".join(header) + "\n")
+        origin_text = "" if origin is None else origin.csv_suffix()
+        self._file.write(VERSION_LINE + origin_text + "\n" + ",".join(header) + "\n")
         self._file.flush()
 
     def write(self, t_s: float, angles_rad, root_m) -> None:
@@ -202,7 +210,8 @@ class CsvTrajectoryWriter:
 
 
 def _from_table(path: Path, t: np.ndarray, angles_deg: np.ndarray, root: np.ndarray, strikes=(),
-                joints: tuple[str, ...] = PITCH_JOINTS, torso_deg: np.ndarray | None = None) -> Trajectory:
+                joints: tuple[str, ...] = PITCH_JOINTS, torso_deg: np.ndarray | None = None,
+                origin: FileOrigin | None = None) -> Trajectory:
     if len(t) < 2:
         raise TrajectoryFileError(f"{path}: needs at least 2 samples, found {len(t)}")
     named = (("t_s", t), ("joint angles", angles_deg), ("root", root), ("torso attitude", torso_deg))
@@ -219,7 +228,7 @@ def _from_table(path: Path, t: np.ndarray, angles_deg: np.ndarray, root: np.ndar
     order = [joints.index(name) for name in canonical(joints)]
     torso = None if torso_deg is None else np.radians(torso_deg.astype(float))
     return Trajectory(t.astype(float), np.radians(angles_deg[:, order].astype(float)), root.astype(float),
-                      tuple(strikes), canonical(joints), torso)
+                      tuple(strikes), canonical(joints), torso, origin)
 
 
 def _csv_layout(path: Path, version: int | None, header: list[str]) -> tuple[tuple[str, ...], bool, bool]:
@@ -282,15 +291,15 @@ def _load_csv(path: Path) -> Trajectory:
         raise TrajectoryFileError(f"{path}: cannot read (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
     except OSError as exc:
         raise TrajectoryFileError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    version, origin, skipped = None, None, 0
+    head, _, rest = text.partition("\n")
+    if head.startswith("#"):
+        head, origin = _split_origin(path, head)
+        version, text, skipped = _read_version_line(path, head.strip()), rest, 1
     try:
         rows = list(csv.reader(io.StringIO(text)))
     except csv.Error as exc:  # a cell over the csv module's field limit, a NUL byte ...
         raise TrajectoryFileError(f"{path}: not a CSV table ({exc})") from None
-    if rows and rows[0] and rows[0][0].startswith("#"):
-        version = _read_version_line(path, ",".join(rows[0]).strip())
-        rows = rows[1:]
-    else:
-        version = None
     if not rows:
         raise TrajectoryFileError(f"{path}: empty file (expected a header row, e.g. {','.join(V1_COLUMNS)})")
     header = [h.strip() for h in rows[0]]
@@ -299,7 +308,7 @@ def _load_csv(path: Path) -> Trajectory:
     wanted = ("t_s",) + tuple(f"{n}_deg" for n in joints) + root_columns + (TORSO_COLUMNS if torso else ())
     index = [header.index(c) for c in wanted]
     data = []
-    for line_no, row in enumerate(rows[1:], start=2 + (version is not None)):
+    for line_no, row in enumerate(rows[1:], start=2 + skipped):
         if not row or all(not cell.strip() for cell in row):
             continue
         if len(row) != len(header):
@@ -315,7 +324,18 @@ def _load_csv(path: Path) -> Trajectory:
     else:
         root = table[:, 1 + j:4 + j]
     torso_deg = table[:, 4 + j:7 + j] if torso else None
-    return _from_table(path, table[:, 0], table[:, 1:1 + j], root, joints=joints, torso_deg=torso_deg)
+    return _from_table(path, table[:, 0], table[:, 1:1 + j], root, joints=joints, torso_deg=torso_deg, origin=origin)
+
+
+def _split_origin(path: Path, line: str) -> tuple[str, FileOrigin | None]:
+    """A version line, split into the version and the origin after it (`` origin: {...}``; None: none)."""
+    at = line.find(CSV_PREFIX)
+    if at < 0:
+        return line, None
+    try:
+        return line[:at], origin_from_csv_text(line[at + len(CSV_PREFIX):].strip())
+    except OriginProblem as exc:
+        raise TrajectoryFileError(f"{path}: line 1, origin: {exc}") from None
 
 
 def _load_npz(path: Path) -> Trajectory:
@@ -335,9 +355,10 @@ def _load_npz(path: Path) -> Trajectory:
         width = 3 if version == 1 else 4
         raw = (numeric(arrays, "heel_strikes", 2, columns=width, finite=False) if "heel_strikes" in arrays
                else np.zeros((0, width)))
+        origin = origin_from_npz(arrays)
     except OSError as exc:
         raise TrajectoryFileError(f"{path}: cannot read ({exc.strerror or exc})") from None
-    except NpzProblem as exc:
+    except (NpzProblem, OriginProblem) as exc:
         raise TrajectoryFileError(f"{path}: {exc}") from None
     if ang.shape[0] != len(t) or root.shape[0] != len(t) or (torso is not None and torso.shape[0] != len(t)):
         raise TrajectoryFileError(f"{path}: arrays have inconsistent shapes t_s{t.shape} angles_deg{ang.shape} "
@@ -350,7 +371,7 @@ def _load_npz(path: Path) -> Trajectory:
         root = sagittal_to_world(root)
     strikes = [HeelStrike(float(r[0]), "left" if int(r[1]) == 0 else "right", float(r[2]),
                           None if len(r) < 4 or not np.isfinite(r[3]) else float(r[3])) for r in raw]
-    return _from_table(path, t, ang, root, strikes, names, torso)
+    return _from_table(path, t, ang, root, strikes, names, torso, origin)
 
 
 def _npz_joint_names(path: Path, arrays: dict, version: int) -> tuple[str, ...]:
@@ -381,7 +402,8 @@ def load_fast(path: str | Path) -> Trajectory:
     if path.suffix == ".csv" and path.is_file():
         try:
             with open(path, encoding="utf-8") as f:
-                if f.readline().strip() == VERSION_LINE:
+                first, origin = _split_origin(path, f.readline(MAX_LINE_CHARS + 64))
+                if first.strip() == VERSION_LINE:
                     header = f.readline().strip().split(",")
                     joints = tuple(c[:-4] for c in header[1:] if c.endswith("_deg") and c not in TORSO_COLUMNS)
                     if (all(is_leg_joint(n) for n in joints) and joints == canonical(joints)
@@ -391,7 +413,7 @@ def load_fast(path: str | Path) -> Trajectory:
                         j = len(joints)
                         if table.shape[1] == len(header):  # the same checks and bounds as Trajectory.load
                             return _from_table(path, table[:, 0].copy(), table[:, 1:1 + j],
-                                               table[:, 1 + j:4 + j].copy(), joints=joints)
+                                               table[:, 1 + j:4 + j].copy(), joints=joints, origin=origin)
         except TrajectoryFileError:
             raise
         except (OSError, UnicodeDecodeError, ValueError):
@@ -428,3 +450,21 @@ def refuse_truncated_csv(path: str | Path) -> None:
     if last not in (b"\n", b"\r"):
         raise TrajectoryFileError(f"{path}: truncated (the last line has no newline, so its last row may be cut "
                                   "short; if the file is complete, end it with a newline)")
+
+
+def read_origin(path: str | Path) -> FileOrigin | None:
+    """The robot and terrain a trajectory file says it was made for, read without reading its table (a
+    command picks its robot before it plans); None when it says nothing or is no file (the reader says why)."""
+    path = Path(path)
+    try:
+        if not path.is_file():
+            return None
+        if path.suffix == ".npz":
+            return origin_from_npz(read_npz(path, only=ORIGIN_ARRAYS))
+        with open(path, encoding="utf-8", errors="replace") as f:
+            first, origin = _split_origin(path, f.readline(MAX_LINE_CHARS + 64))
+    except OSError:
+        return None
+    except (NpzProblem, OriginProblem) as exc:
+        raise TrajectoryFileError(f"{path}: {exc}") from None
+    return origin if first.strip() == VERSION_LINE else None

@@ -39,7 +39,8 @@ def _footprints(trace, side: str) -> list[np.ndarray]:
 
 def plot_balance(trajectory: Trajectory, config: RobotConfig, out: Path, title: str = "", commands=None) -> None:
     """Joint angles, the top view (footprints as the forward kinematics turns them, CoM, ZMP, support) and
-    the torso's attitude; with ``commands`` (a steered walk's timed commands) a fourth panel of them."""
+    the torso's attitude where the walk turns it (a torso held upright throughout gets no empty panel, the
+    top view's title says so); with ``commands`` (a steered walk's timed commands) a panel of them."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -48,12 +49,14 @@ def plot_balance(trajectory: Trajectory, config: RobotConfig, out: Path, title: 
 
     trace = balance_trace(config, trajectory, robot_angles_deg(config, trajectory))
     t = trajectory.t_s
-    panels = 3 if commands is None else 4
-    fig = plt.figure(figsize=(12, 10 if commands is None else 12), constrained_layout=True)
-    grid = fig.add_gridspec(panels, 1, height_ratios=[1.0, 1.3, 0.6, 0.6][:panels])
-    ax_angles, ax_top, ax_torso = (fig.add_subplot(grid[i]) for i in range(3))
+    rpy = None if trajectory.torso_rpy_rad is None else np.degrees(trajectory.torso_rpy_rad)
+    turns = rpy is not None and bool(np.any(np.abs(rpy) > 1e-9))
+    heights = [1.0, 1.3] + [0.6] * turns + [0.6] * (commands is not None)
+    fig = plt.figure(figsize=(12, 4.4 + 2.6 * len(heights)), constrained_layout=True)
+    grid = fig.add_gridspec(len(heights), 1, height_ratios=heights)
+    ax_angles, ax_top = fig.add_subplot(grid[0]), fig.add_subplot(grid[1])
     if commands is not None:
-        draw_commands(fig.add_subplot(grid[3]), commands, float(t[-1]))
+        draw_commands(fig.add_subplot(grid[len(heights) - 1]), commands, float(t[-1]))
 
     for i, name in enumerate(trajectory.joints):
         kind, side = name.rsplit("_", 1)
@@ -91,17 +94,18 @@ def plot_balance(trajectory: Trajectory, config: RobotConfig, out: Path, title: 
     ax_top.set_ylabel("y left (m)")
     k = int(np.argmin(trace.margin_m))
     ax_top.set_title(f"top view: footprints (left blue, right red); least ZMP margin "
-                     f"{1e3 * trace.margin_m[k]:.1f} mm at t={t[k]:.2f} s", fontsize=10)
+                     f"{1e3 * trace.margin_m[k]:.1f} mm at t={t[k]:.2f} s"
+                     + ("" if turns else "; the torso stays upright throughout"), fontsize=10)
     ax_top.legend(fontsize=8, loc="upper left", ncol=3)
     ax_top.grid(alpha=0.3)
 
-    rpy = np.degrees(trajectory.torso_rpy_rad) if trajectory.torso_rpy_rad is not None else np.zeros((len(t), 3))
-    for j, (name, colour) in enumerate((("roll", "tab:purple"), ("pitch", "tab:orange"), ("yaw", "tab:gray"))):
-        ax_torso.plot(t, rpy[:, j], color=colour, lw=1.2, label=name)
-    ax_torso.set_ylabel("torso (deg)")
-    ax_torso.set_xlabel("time (s)" + ("" if trajectory.torso_rpy_rad is not None else
-                                      ": the gait keeps the torso upright"))
-    ax_torso.legend(ncol=3, fontsize=8, loc="upper right")
-    ax_torso.grid(alpha=0.3)
+    if turns:
+        ax_torso = fig.add_subplot(grid[2])
+        for j, (name, colour) in enumerate((("roll", "tab:purple"), ("pitch", "tab:orange"), ("yaw", "tab:gray"))):
+            ax_torso.plot(t, rpy[:, j], color=colour, lw=1.2, label=name)
+        ax_torso.set_ylabel("torso (deg)")
+        ax_torso.set_xlabel("time (s)")
+        ax_torso.legend(ncol=3, fontsize=8, loc="upper right")
+        ax_torso.grid(alpha=0.3)
     fig.savefig(out, dpi=110)
     plt.close(fig)

@@ -168,7 +168,7 @@ def trajectory_figure(trajectory: Trajectory, geometry: LegGeometry, clearance: 
     ax_stick.set_ylim(bottom, None)
     ax_stick.set_aspect("equal")
     ax_stick.set_xlabel(f"x (m): poses at {len(frames)} heel strikes (right leg dark, left pale)")
-    ax_stick.set_ylabel("y (m)")
+    ax_stick.set_ylabel("z (m)")
     ax_stick.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
     return fig
 

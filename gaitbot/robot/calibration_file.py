@@ -154,3 +154,22 @@ def write_calibration(path: str | Path, robot: str, joints: list[JointCalibratio
             lines.append(f"moved_deg = {j.moved_deg:.1f}")
         lines.append("")
     Path(path).write_text("\n".join(lines), encoding="utf-8")
+
+
+def sent_calibration(config: RobotConfig) -> dict:
+    """What a recording's header keeps of the calibration a walk was sent with: the file (None: the
+    config's own zero ticks) and every joint's zero tick and direction, so that ``gaitbot check`` decodes
+    the recording as it was sent, whatever calibration lies beside the config later."""
+    return {"file": None if config.calibration_file is None else str(Path(config.calibration_file).resolve()),
+            "joints": {j.name: {"zero_tick": int(j.zero_tick), "direction": int(j.direction)} for j in config.joints}}
+
+
+def with_sent_calibration(config: RobotConfig, sent: dict, recording: str | Path) -> RobotConfig:
+    """``config`` (without a calibration of its own) with the zero ticks and directions a recording's header
+    says it was sent with (:func:`sent_calibration`), checked as a calibration file's are."""
+    by_name = {j.name: j for j in config.joints}
+    joints = tuple(JointCalibration(name, by_name[name].id, by_name[name].model.name, int(v["zero_tick"]),
+                                    int(v["direction"])) for name, v in sent["joints"].items() if name in by_name)
+    applied = apply_calibration(config, CalibrationFile(Path(recording), config.name, joints))
+    file = sent.get("file")
+    return dataclasses.replace(applied, calibration_file=Path(file) if file else None)

@@ -72,6 +72,12 @@ def check_bus_rate(config: RobotConfig, rate_hz: float) -> FrameBudget:
                       config.bus.baudrate, read_back=True)
 
 
+#: Where a robot whose legs roll may have its ankle axis along (and across) its sole, as fractions of the sole's
+#: length from the heel (and of its width about its centre): its middle half. The shipped robots have theirs
+#: at the middle (op3, bioloid); a hand-written 12-joint config with the ankle at the heel planned walks that
+#: lifted both feet.
+SOLE_MIDDLE = (0.25, 0.75)
+
 #: Bounds of every size a config can ask for (value ranges, both ends included; the shipped robots sit
 #: well inside them). Beyond them a field is refused on load, before any work: a cycle of 1e9 s or a
 #: step of 1e-9 m would otherwise ask for gigabytes of frames (docs/robot-config.md).
@@ -141,6 +147,7 @@ class _Reader(Fields):
                              mass=mass, servo=servo, terrain=terrain, health=health, balance=balance, links=links,
                              boom=boom, draft=draft, steer=read_steer(self, data), imu=read_imu(self, data, bus))
         self.three_d_checks(config)
+        self.soles_stand(config, data["geometry"])
         return config
 
     def walkable(self, geometry: Geometry, gait: GaitSettings) -> None:
@@ -260,6 +267,28 @@ class _Reader(Fields):
                                 f"a flat sole needs ankle_roll = -hip_roll; to bring the body over one foot the hip "
                                 f"rolls {needed:.1f} deg either way, but with these limits the soles stay flat only "
                                 f"for hip_roll {lo:.1f}..{hi:.1f} deg")
+
+    def soles_stand(self, config: RobotConfig, given: dict) -> None:
+        """A robot whose legs roll balances on its soles: it needs the heel's place said, not defaulted, and
+        each ankle over the middle half of its sole (SOLE_MIDDLE), or its balance point has no sole around it
+        and the walk it plans lifts both feet ("no sole touches the ground") or tips."""
+        if not config.is_3d:
+            return
+        g = config.geometry
+        lo, hi = SOLE_MIDDLE[0] * g.foot_m, SOLE_MIDDLE[1] * g.foot_m
+        where = (f"the ankle axis must stand over the middle half of the sole: {lo:.4g}..{hi:.4g} m for "
+                 f"foot_m {g.foot_m:g}")
+        if "heel_back_m" not in given:
+            raise self.fail("geometry.heel_back_m", f"missing (a robot whose legs roll stands on its soles: give "
+                                                    f"how far the heel reaches behind the ankle axis, metres; {where})")
+        if not lo <= g.heel_back_m <= hi:
+            raise self.fail("geometry.heel_back_m", f"{g.heel_back_m:g} m puts the ankle too near the "
+                                                    f"{'heel' if g.heel_back_m < lo else 'toe'}: {where}")
+        side = SOLE_MIDDLE[1] - 0.5
+        if abs(g.sole_outward_m) > side * g.foot_width_m:
+            raise self.fail("geometry.sole_outward_m", f"{g.sole_outward_m:g} m: the ankle must stand over the middle "
+                                                       f"half of the sole's width, within +-{side * g.foot_width_m:.4g} "
+                                                       f"m for foot_width_m {g.foot_width_m:g}")
 
     def servo(self, t: dict) -> ServoSettings:
         return ServoSettings(**{k: self.number(t, k, "servo", positive=True) if k in t else None

@@ -17,7 +17,7 @@ import numpy as np
 from gaitbot.sim import SIM_EXTRA_HINT, SimUnavailable, VideoError
 from gaitbot.sim.physics import SimRobot
 
-FORMATS = {".gif": 20.0, ".mp4": 30.0}  # frames per second of each format
+FORMATS = {".gif": 20.0, ".mp4": 20.0}  # frames per second of each format
 SIZE = {".gif": (480, 320), ".mp4": (640, 352)}  # width, height (MP4: multiples of 16)
 MARKER_RGBA = {"left": (0.1, 0.65, 0.2, 1.0), "right": (0.85, 0.15, 0.15, 1.0)}
 

@@ -91,3 +91,20 @@ def test_jargon_in_the_plans_is_explained(capsys):
     code, out, _ = run_cli(capsys, "plan", "--terrain", CONFIG_DIR / "terrain" / "kerb.toml")
     assert code == 0 and "(mid double support, MDS)" in out
     assert not any(line.startswith("MDS") for line in out.splitlines())
+
+
+@pytest.mark.parametrize("value", ["-0.05,-0.05", "-0.05", "0.05,-0.05", "-.05, -5e-2"])
+def test_a_negative_step_list_is_a_value_not_an_option(capsys, value):
+    """argparse takes "-0.05,-0.05" for an option ("expected one argument"); it is a list of steps, refused
+    by what it says (one line naming the step), exit 2."""
+    code, out, err = run_cli(capsys, "plan", "--steps", value)
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "step lengths must be 0 or more" in err and "expected one argument" not in err
+
+
+def test_a_negative_velocity_is_a_value(capsys):
+    code, out, err = run_cli(capsys, "plan", "--robot", "op3", "--velocity", "-0.02,0,0", "--duration", "3")
+    assert code == 0, err
+    with pytest.raises(SystemExit) as stop:  # an option is still an option
+        run_cli(capsys, "plan", "--steps", "--distance", "1")
+    assert stop.value.code == 2 and "expected one argument" in capsys.readouterr().err

@@ -86,6 +86,8 @@ CASES = [
     ("robot export", "robot export op3", 2),  # no output named
     ("robot import", "robot import {out}/op3.urdf --like op3 -o {out}/mine.toml", 0),
     ("robot import", "robot import {walk} -o {out}/mine.toml", 2),  # a CSV is not a robot description
+    ("robot new", "robot new mybot --legs 12 -o {out}/mybot.toml", 0),
+    ("robot new", "robot new mybot --legs 12 -o {out}/mybot.csv", 2),  # a config is a .toml
     ("drive", "drive --robot op3 --dry-run --input commands:{commands}", 0),
     ("drive", "drive --robot xl430-biped --dry-run --input commands:{commands}", 2),  # no [steer]
 ]

@@ -52,7 +52,7 @@ def test_generate_csv(tmp_path, capsys):
     assert main(["generate", "--steps", "0.05,0.08", "-o", str(out)]) == 0
     assert "wrote" in capsys.readouterr().out
     lines = out.read_text().splitlines()
-    assert lines[:2] == ["# gaitbot trajectory 2", HEADER]
+    assert lines[0].startswith("# gaitbot trajectory 2 origin: {") and lines[1] == HEADER
     walk = Trajectory.load(out)
     np.testing.assert_allclose(walk.angles_rad[[0, -1]], 0.0, atol=1e-9)
     # the root travels the 0.13 m of the steps (it starts over the ankles, heel_back ahead of the heels at 0)

@@ -75,3 +75,33 @@ def test_heel_strikes_are_drawn_to_be_seen_and_stick_figures_are_few(figure, ker
     assert all(line.get_linewidth() >= 1.0 and line.get_alpha() >= 0.7 for line in strikes)
     legs = [line for line in ax_stick.get_lines() if len(line.get_xdata()) == 6]
     assert 2 * 4 <= len(legs) <= 2 * MAX_POSES
+
+
+def test_the_stick_figure_height_is_z(figure):
+    """The files and the world frame call height z (REP-103: x forward, y left, z up)."""
+    stick = [ax for ax in figure.axes if ax.get_xlabel().startswith("x (m)")]
+    assert len(stick) == 1 and stick[0].get_ylabel() == "z (m)"
+
+
+def test_a_torso_held_upright_gets_no_empty_panel(tmp_path, monkeypatch):
+    """op3's straight walk keeps its torso upright: no panel of three flat lines; a turning walk keeps it."""
+    import dataclasses
+
+    from matplotlib.figure import Figure
+
+    from gaitbot.app.planned_walk import balanced_plan
+    from gaitbot.app.options import gait_source
+    from gaitbot.plot.balance import plot_balance
+    from argparse import Namespace
+
+    robot = config("op3")
+    source = gait_source(Namespace(robot="op3", thigh=None, shank=None, foot=None, clearance=None, rate=None), robot)
+    walk = balanced_plan(source, [0.04, 0.04], None).walk.trajectory()
+    seen = []
+    monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: seen.append([ax.get_ylabel() for ax in fig.axes]))
+    plot_balance(walk, robot, tmp_path / "a.png")
+    yaw = np.zeros((len(walk), 3))
+    yaw[:, 2] = np.radians(np.linspace(0.0, 30.0, len(walk)))
+    plot_balance(dataclasses.replace(walk, torso_rpy_rad=yaw), robot, tmp_path / "b.png")
+    assert "torso (deg)" not in seen[0] and len(seen[0]) == 2
+    assert "torso (deg)" in seen[1] and len(seen[1]) == 3

@@ -159,7 +159,29 @@ def _header(path: Path, line: str) -> dict:
             servo_model(name)
         except (TypeError, ValueError, KeyError) as exc:
             raise RecordingError(f"{where}: header models.{key}: {' '.join(str(exc).split())}") from None
+    if "calibration" in header:
+        _check_calibration(where, header["calibration"], joints)
     return header
+
+
+def _check_calibration(where: str, sent: Any, joints: dict) -> None:
+    """The optional ``calibration`` header field: the zero tick and direction each joint was sent with
+    (``{"file": path or null, "joints": {name: {"zero_tick": int, "direction": 1 or -1}}}``)."""
+    if not isinstance(sent, dict) or set(sent) != {"file", "joints"} or not isinstance(sent["joints"], dict):
+        raise RecordingError(f"{where}: header calibration must be an object {{\"file\": ..., \"joints\": {{...}}}}")
+    if sent["file"] is not None and not isinstance(sent["file"], str):
+        raise RecordingError(f"{where}: header calibration.file must be a path or null, got {_shown(sent['file'])}")
+    for name, joint in sent["joints"].items():
+        field = f"header calibration.joints.{name}"
+        if name not in joints:
+            raise RecordingError(f"{where}: {field}: not one of the header's joints")
+        if not isinstance(joint, dict) or set(joint) != {"zero_tick", "direction"}:
+            raise RecordingError(f"{where}: {field} must be {{\"zero_tick\": ..., \"direction\": ...}}")
+        tick, direction = joint["zero_tick"], joint["direction"]
+        if isinstance(tick, bool) or not isinstance(tick, int) or not 0 <= tick <= 65535:
+            raise RecordingError(f"{where}: {field}.zero_tick must be a tick 0..65535, got {_shown(tick)}")
+        if direction not in (1, -1) or isinstance(direction, bool):
+            raise RecordingError(f"{where}: {field}.direction must be 1 or -1, got {_shown(direction)}")
 
 
 def _is_number(value: Any) -> bool:

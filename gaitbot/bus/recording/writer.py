@@ -37,8 +37,10 @@ class BusRecorder:
     """Writes one bus log. ``clock`` returns seconds (monotonic); injectable for tests."""
 
     def __init__(self, path: str | Path, *, robot: str, joints: Mapping[str, int],
-                 clock: Callable[[], float] = time.monotonic, rate_hz: float | None = None) -> None:
+                 clock: Callable[[], float] = time.monotonic, rate_hz: float | None = None,
+                 calibration: Mapping[str, Any] | None = None) -> None:
         self.path = Path(path)
+        self.calibration = calibration  # the zero ticks and directions sent with (gaitbot check decodes by them)
         self.rate_hz = rate_hz  # the frame rate of the run, written in the header (gaitbot check uses it)
         self.robot = robot
         self.joints = dict(joints)
@@ -57,6 +59,8 @@ class BusRecorder:
                   "models": {str(i): m.name for i, m in models.items()}}
         if self.rate_hz is not None:
             header["rate_hz"] = float(self.rate_hz)
+        if self.calibration is not None:
+            header["calibration"] = dict(self.calibration)
         self._file = open(self.path, "wb", buffering=0)  # one os-level write per line: no buffer to lose
         self._t0_s = self._clock()
         try:
