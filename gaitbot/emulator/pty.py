@@ -57,6 +57,11 @@ class ServoEmulator:
         with self.lock:
             return self.chain.plug_next()
 
+    def connect_all(self) -> None:
+        """Plug in every servo: the whole chain, as on the robot."""
+        with self.lock:
+            self.chain.connect_all()
+
     def line_baud(self) -> int | None:
         """The rate the driver set on its end of the pty (read from the master side), None if unknown."""
         return line_rate(self.master_fd)
