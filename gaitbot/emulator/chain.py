@@ -52,6 +52,7 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
         self._instruction_rate: int | None = None
         self._rng = random.Random(config.seed)
         self._registered: dict[int, tuple[int, bytes]] = {}
+        self.state_changed = False  # an EEPROM write was kept since the state file was last saved
         self.hand = config.hand
         self.hand_sample = 0
         self._hand_grabbed_s: float | None = None  # when the first torque-off came; None: not yet
@@ -164,6 +165,7 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
 
     def save_state(self) -> None:
         """Keep every servo's EEPROM as saved in the state file, if one was asked for (gaitbot.emulator.state)."""
+        self.state_changed = False
         if self.config.state_path:
             write_state(self.config.state_path, self.config.backend, self.config.protocol,
                         [(u.model, bytes(u.saved)) for u in self.units])
@@ -294,7 +296,7 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
             if not locked:
                 end = min(layout.eeprom_end, address + len(data))
                 unit.saved[address:end] = data[:end - address]
-                self.save_state()
+                self.state_changed = True  # saved once the replies are out (ServoEmulator.serve), not in their way
         self.writes.append((unit.index, servo_id, address, bytes(data), True))
         self._grab_by_hand(servo_id, address, data)
 

@@ -98,6 +98,9 @@ class ServoEmulator:
                     due = chain.due(now_s)
                 for packet in due:
                     self._write(packet)
+                if chain.state_changed and not chain.outbox:  # the servos' EEPROM to the state file, off the line
+                    with self.lock:
+                        chain.save_state()
                 if chain.should_close(now_s):
                     self._close(f"port closed after {chain.goal_frames} goal frames (fault injection)")
                     return
@@ -117,6 +120,8 @@ class ServoEmulator:
         if self._done.is_set():
             return
         self.closed_reason = reason
+        if self.chain.state_changed:
+            self.chain.save_state()
         for fd in (self.master_fd, self.slave_fd):  # closing the master hangs up the driver's end
             try:
                 os.close(fd)

@@ -94,6 +94,8 @@ def test_the_state_file_keeps_each_servos_id_across_a_restart(robot_name, tmp_pa
         if k:
             chain.plug_next()
         write_id(chain, 1, 10 + k)  # the servo plugged in now leaves id 1
+    assert chain.state_changed
+    chain.save_state()  # what the pty server does once the replies are out
     restored = tuple(read_state(state, robot.bus.backend, robot.bus.protocol))
     again = se.EmulatedChain(se.EmulatorConfig(robot.bus.backend, robot.bus.protocol, {}, robot.bus.baudrate,
                                                restored=restored))
@@ -127,6 +129,7 @@ def test_the_emulator_command_line_restores_the_chain_of_a_state_file(tmp_path):
     chain = se.EmulatedChain(fresh_config(robot, state, one_at_a_time=False))
     chain.line_baud = None
     write_id(chain, 1, 7)  # all six at id 1 hear it: they all become 7
+    chain.save_state()
     args = emulator_cli.build_parser().parse_args(["--robot", "xl430-biped", "--state", str(state)])
     restored = emulator_cli.config_from_args(args)
     assert restored.models == {7: robot.joints[0].model} and len(restored.restored) == len(robot.joints)
