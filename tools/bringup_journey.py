@@ -37,7 +37,10 @@ from gaitbot.robot.config import load_robot_config, resolve_config  # noqa: E402
 STEP_TIMEOUT_S = 300.0
 #: The commands run this checkout's gaitbot, as this script does.
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in (str(CHECKOUT), os.environ.get("PYTHONPATH")) if p)}
-SEARCH_TIMEOUT = ["--reply-timeout-ms", "5"]  # the emulator answers within a millisecond or two
+SEARCH_TIMEOUT = ["--reply-timeout-ms", "5"]  # setup: one servo on the line; the emulator answers within a ms or two
+#: scan: six servos answer a broadcast ping in turn, and a busy host can hold the emulator's next reply back
+#: longer than 5 ms, which would end the listening early (docs/bring-up.md): a 50 ms quiet window.
+SCAN_TIMEOUT = ["--reply-timeout-ms", "50"]
 #: A busy host delays the emulator's replies for reasons no servo has (docs/bring-up.md): the walk and
 #: the calibration wait longer for each status packet.
 BUSY_HOST_TIMEOUT = ["--reply-timeout-ms", "250"]
@@ -131,7 +134,7 @@ def journey(robot: str, folder: Path, seed: int = 0) -> list[str]:
         if set_up(folder, robot, emulator) != 0:
             return ["gaitbot setup did not set up every servo"]
         emulator.enter()  # once more after the last: the whole chain
-        code, _ = gaitbot(folder, ["scan", "--robot", robot, "--port", emulator.path, *SEARCH_TIMEOUT])
+        code, _ = gaitbot(folder, ["scan", "--robot", robot, "--port", emulator.path, *SCAN_TIMEOUT])
         if code != 0:
             problems.append("gaitbot scan did not find every servo of the config at its id and rate")
     finally:
