@@ -24,7 +24,8 @@ from gaitbot.stream.calibrate import CalibrationJoint, CalibrationStopped, calib
 
 ZERO_POSE = ("Hold the robot in its zero pose: legs straight, feet flat and parallel, torso upright "
              "(docs/bring-up.md has a picture). Press Enter.")
-BEND = "{joint}: {words}, by 20 degrees or more, and hold it there. Press Enter."
+BEND = ("{joint}: {words}, by 20 degrees or more (the joints bent before may stay bent or go back to zero). "
+        "Hold it there. Press Enter.")
 QUESTION = "Turn torque off on {n} servos? The legs will go limp: hold the robot. [y/N] "
 
 
@@ -56,7 +57,8 @@ def _confirm(yes: bool):
 def add_parser(subparsers):
     p = add_command(subparsers, "calibrate")
     p.add_argument("--robot", help="robot config (default xl430-biped)")
-    p.add_argument("-o", "--output", required=True, help="calibration file to write (.toml)")
+    p.add_argument("-o", "--output", help="calibration file to write (.toml; default: where every command finds "
+                   "it, beside your config as <config stem>.calibration.toml, for a shipped robot in this folder)")
     p.add_argument("--port", help="serial port (default: the robot config's)")
     p.add_argument("--yes", action="store_true", help="turn torque off without asking")
     p.add_argument("--reply-timeout-ms", type=float, metavar="MS", help=REPLY_TIMEOUT_HELP)
@@ -65,7 +67,7 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     config = load_robot(args.robot, None)  # measured as the config describes the servos, without any calibration
-    out = Path(args.output)
+    out = Path(args.output) if args.output is not None else calibration_path_for(config.path)
     _check_output(out)
     output_path(out, "-o", args)
     check_reply_timeout(args.reply_timeout_ms)
@@ -82,7 +84,7 @@ def run(args) -> int:
     apply_calibration(config, CalibrationFile(out, config.name, tuple(calibrated)))  # refuses what cannot hold
     comment = (f"gaitbot calibrate --robot {config.path}: zero ticks and directions of {config.name}'s servos,\n"
                "measured on the robot (docs/file-formats.md). Applied on top of the config by --calibration,\n"
-               "or found beside the config as <config stem>.calibration.toml.")
+               "or found by default as " + str(calibration_path_for(config.path)) + ".")
     write_output(out, lambda path: write_calibration(path, config.name, calibrated, comment=comment))
     print(f"{'joint':20s} {'id':>4s} {'zero tick':>9s} {'direction':>9s} {'bent deg':>8s}  was (config)")
     by_name = {j.name: j for j in config.joints}
@@ -92,7 +94,9 @@ def run(args) -> int:
               f"{was.zero_tick} / {was.direction:+d}")
         for note in r.notes:
             print(f"warning: {r.name}: {note}", file=sys.stderr)
-    print(f"wrote {out}: {len(results)} joints of {config.name}; torque stays off. Use it with --calibration {out}"
-          + ("" if out.resolve() == calibration_path_for(config.path).resolve() else
-             f", or name it {calibration_path_for(config.path)} to have it found beside the config"))
+    own = calibration_path_for(config.path)
+    print(f"wrote {out}: {len(results)} joints of {config.name}; torque stays off. "
+          + (f"Every command given --robot {config.path} applies it from there (or give --calibration FILE)."
+             if out.resolve() == own.resolve() else
+             f"Use it with --calibration {out}, or name it {own} to have it found by default"))
     return 0

@@ -11,8 +11,10 @@ and answers on it like a chain of servos until Ctrl-C:
 
 Faults (and the supply's sag) start after ``--fault-after-frames`` goal frames and ``--fault-after-s``
 seconds from the first packet received (default: at once). With ``--one-at-a-time``, each line read on
-standard input (Enter) unplugs the servo connected now and plugs in the next. docs/emulator.md lists
-every option.
+standard input (Enter) unplugs the servo connected now and plugs in the next, and after the last one
+connects them all (the whole chain, for gaitbot scan and calibrate). ``--state FILE`` keeps the servos'
+EEPROM across restarts; ``--hand-calibrate`` stands in for the person gaitbot calibrate asks to bend the
+joints. docs/emulator.md lists every option.
 """
 
 from __future__ import annotations
@@ -20,12 +22,18 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from pathlib import Path
 
 from gaitbot.app.cli import OneLineParser
+from gaitbot.app.emulator_hand import calibration_hand, mounting_zero_ticks
+from gaitbot.bus.factory import stand_ticks_by_id
 from gaitbot.emulator import FAULT_KINDS, EmulatorConfig, Faults, Hand, Heat, ServoEmulator, hand_from_ticks
+from gaitbot.emulator.state import read_state
+from gaitbot.emulator.units import LAYOUTS
 from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.calibration import trajectory_ticks
 from gaitbot.robot.calibration_file import load_robot_with_calibration
+from gaitbot.robot.config import load_robot_config, resolve_config
 from gaitbot.servos import baud_rates, baud_register_value
 from gaitbot.servos.models import servo_model
 
@@ -167,20 +175,13 @@ def _chain_from_args(args: argparse.Namespace) -> EmulatorConfig:
         if not kinds <= set(FAULT_KINDS):
             raise ValueError(f"--error {item!r}: kinds are {', '.join(FAULT_KINDS)} (join with +)")
         faults.errors[servo_id] = kinds
-    if args.hand and args.hand_ticks:
-        raise ValueError("give --hand or --hand-ticks, not both")
+    if sum(bool(x) for x in (args.hand, args.hand_ticks, args.hand_calibrate)) > 1:
+        raise ValueError("give one of --hand, --hand-ticks and --hand-calibrate")
     hand = hand_from_ticks(args.hand_ticks, args.hand_rate) if args.hand_ticks else None
     if args.robot:
-        robot = load_robot_with_calibration(args.robot, args.calibration)
-        check_fault_ids(faults, robot.models_by_id)
-        if args.hand:
-            hand = hand_from_trajectory(robot, args.hand, args.hand_rate)
-        fresh = tuple(j.model for j in robot.joints)[:args.factory_fresh or None] \
-            if args.factory_fresh is not None else ()
-        return EmulatorConfig(robot.bus.backend, robot.bus.protocol, {} if fresh else robot.models_by_id,
-                              args.baudrate or robot.bus.baudrate, faults, args.log, robot.name,
-                              None if fresh else {j.name: j.id for j in robot.joints}, args.seed,
-                              args.return_delay_us, hand, fresh=fresh)
+        return _robot_chain(args, faults, hand)
+    if args.hand_calibrate:
+        raise ValueError("--hand-calibrate needs --robot (the joints to bend, in the config's order)")
     if args.hand:
         raise ValueError("--hand needs --robot (its calibration turns the trajectory's angles into ticks)")
     if args.calibration:
@@ -195,11 +196,49 @@ def _chain_from_args(args: argparse.Namespace) -> EmulatorConfig:
         if args.factory_fresh < 1:
             raise ValueError("--factory-fresh N: without --robot, give how many servos (1 or more)")
         return EmulatorConfig(backend, protocol, {}, args.baudrate or 1_000_000, faults, args.log, seed=args.seed,
-                              return_delay_us=args.return_delay_us, hand=hand, fresh=(model,) * args.factory_fresh)
-    models = {i: model for i in parse_ids(args.ids)}
+                              return_delay_us=args.return_delay_us, hand=hand, fresh=(model,) * args.factory_fresh,
+                              state_path=args.state)
+    restored = _restored(args, backend, protocol)
+    models = _models_of(restored) if restored else {i: model for i in parse_ids(args.ids)}
     check_fault_ids(faults, models)
     return EmulatorConfig(backend, protocol, models, args.baudrate or 1_000_000, faults, args.log,
-                          seed=args.seed, return_delay_us=args.return_delay_us, hand=hand)
+                          seed=args.seed, return_delay_us=args.return_delay_us, hand=hand, restored=restored,
+                          state_path=args.state)
+
+
+def _restored(args: argparse.Namespace, backend: str, protocol: float) -> tuple:
+    """The servos of an existing ``--state`` file (none with --factory-fresh: new servos start it afresh)."""
+    if not args.state or args.factory_fresh is not None or not Path(args.state).exists():
+        return ()
+    return tuple(read_state(args.state, backend, protocol))
+
+
+def _models_of(restored) -> dict:
+    ids = [eeprom[LAYOUTS[model.name].id_addr] for model, eeprom in restored]
+    return {servo_id: model for servo_id, (model, _eeprom) in zip(ids, restored)}
+
+
+def _robot_chain(args: argparse.Namespace, faults: Faults, hand: Hand | None) -> EmulatorConfig:
+    """The chain of a robot config: its servos (or factory-fresh ones, or those of a --state file), standing
+    where the robot stands (the stand pose in its calibrated ticks; with --hand-calibrate, the build's)."""
+    robot = load_robot_with_calibration(args.robot, args.calibration)
+    check_fault_ids(faults, robot.models_by_id)
+    if args.hand:
+        hand = hand_from_trajectory(robot, args.hand, args.hand_rate)
+    start = stand_ticks_by_id(robot)
+    if args.hand_calibrate:
+        design = load_robot_config(resolve_config(args.robot))  # the servos as built, not as calibrated
+        hand = calibration_hand(design, args.seed)
+        start = mounting_zero_ticks(design, args.seed)
+    fresh = tuple(j.model for j in robot.joints)[:args.factory_fresh or None] \
+        if args.factory_fresh is not None else ()
+    restored = _restored(args, robot.bus.backend, robot.bus.protocol)
+    models = {} if fresh else (_models_of(restored) if restored else robot.models_by_id)
+    return EmulatorConfig(robot.bus.backend, robot.bus.protocol, models,
+                          args.baudrate or robot.bus.baudrate, faults, args.log, robot.name,
+                          None if fresh else {j.name: j.id for j in robot.joints if j.id in models}, args.seed,
+                          args.return_delay_us, hand, fresh=fresh, start_ticks=start, restored=restored,
+                          state_path=args.state)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -226,6 +265,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "while their torque is off, one sample per read cycle")
     p.add_argument("--hand-ticks", metavar="FILE", help="a hand script in raw ticks: a CSV whose header holds servo "
                    "ids and each row one sample (no calibration involved), e.g. a scripted hand for gaitbot calibrate")
+    p.add_argument("--hand-calibrate", action="store_true", help="with --robot: stand in for the person gaitbot "
+                   "calibrate asks: the servos are mounted up to a few degrees off the config's zero (drawn from "
+                   "--seed), and the hand holds the zero pose, then bends each joint its positive way and lets it back")
+    p.add_argument("--state", metavar="FILE", help="keep the servos' EEPROM (ids, baud rates) in FILE: a later run "
+                   "with the same FILE has the same servos, all connected (--factory-fresh starts FILE afresh)")
     p.add_argument("--hand-rate", type=float, metavar="HZ", help="advance the --hand script with time at HZ instead")
     p.add_argument("--calibration", metavar="FILE", help="with --robot: a calibration file applied to the config "
                    "(for --hand), as gaitbot's commands apply it")
@@ -269,7 +313,8 @@ def main(argv: list[str] | None = None) -> int:
               f"{how}, on {config.backend} protocol {config.protocol}; Ctrl-C to stop", file=sys.stderr, flush=True)
     else:
         names = sorted({m.name for m in config.models.values()})
-        print(f"emulating {len(config.models)} {'/'.join(names)} servos (ids {sorted(config.models)}) on "
+        kept = f" as kept in {config.state_path}" if config.restored else ""
+        print(f"emulating {len(config.models)} {'/'.join(names)} servos (ids {sorted(config.models)}){kept} on "
               f"{config.backend} protocol {config.protocol}; Ctrl-C to stop", file=sys.stderr, flush=True)
     try:
         if config.one_at_a_time:
@@ -297,7 +342,10 @@ def _plug_on_enter(emulator: ServoEmulator) -> None:
     for _line in sys.stdin:
         unit = emulator.plug_next()
         if unit is None:
-            print(f"no servo left to plug in (all {total} done)", file=sys.stderr, flush=True)
+            emulator.connect_all()
+            ids = ", ".join(str(u.servo_id) for u in emulator.chain.units)
+            print(f"all {total} servos connected: the whole chain, as on the robot (ids {ids})", file=sys.stderr,
+                  flush=True)
             continue
         print(f"servo {unit.index + 1} of {total} connected ({unit.model.name}, id {unit.servo_id})",
               file=sys.stderr, flush=True)

@@ -136,7 +136,8 @@ COMMAND_HELP = {
         "Ping every id at every baud rate of the configured protocol (or --baud) and list each servo that\n"
         "answers: id, baud rate, model, firmware, present position (ticks and as its joint's angle), input\n"
         "voltage, temperature, load, torque and hardware errors in words; then the configured joints that\n"
-        "did not answer. Reads only. Exit 0 when every configured joint answered as configured, else 1.",
+        "did not answer. Reads only; a progress bar on a terminal. Exit 0 when every configured joint\n"
+        "answered as configured, else 1.",
         ("gaitbot scan --dry-run",
          "gaitbot scan --robot ax12a-biped --dry-run --json")),
     "setup": CommandHelp(
@@ -154,12 +155,13 @@ COMMAND_HELP = {
         "Torque off; you hold the robot in its zero pose (legs straight, feet flat) and press Enter: the\n"
         "present positions become the zero ticks. Then, joint by joint, you bend the joint in its positive\n"
         "direction (told in words) and press Enter: the sign of the change is its direction, the size is\n"
-        "checked against the configured limits. Writes the calibration file, which every command applies on\n"
-        "top of the config (--calibration FILE, or <config stem>.calibration.toml beside the config).\n"
-        "Writes only Torque Enable = 0 to the servos (docs/bring-up.md).",
+        "checked against the configured limits. Writes the calibration file where every command finds it\n"
+        "and applies it on top of the config: <config stem>.calibration.toml beside your config, or in this\n"
+        "folder for a shipped robot (or -o FILE, then --calibration FILE). Writes only Torque Enable = 0 to\n"
+        "the servos (docs/bring-up.md).",
         ("gaitbot calibrate --help",),
-        ("gaitbot calibrate --robot robots/mybot.toml -o robots/mybot.calibration.toml",
-         "gaitbot walk --robot robots/mybot.toml --calibration robots/mybot.calibration.toml --distance 0.5")),
+        ("gaitbot calibrate --robot robots/mybot.toml",
+         "gaitbot walk --robot robots/mybot.toml --distance 0.5   # applies robots/mybot.calibration.toml")),
     "robot": CommandHelp(
         "a new robot config, or a robot config to and from URDF and MJCF (the field's robot descriptions)",
         "Start a new robot from a complete commented template (robot new), export a robot config as URDF or\n"

@@ -15,8 +15,24 @@ from gaitbot.app.arguments import add_command, bus_options, robot_options
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
 from gaitbot.bus.bringup import ServoReport, describe_servo, survey
-from gaitbot.bus.factory import make_probe_bus
-from gaitbot.servos import common_baud_rates, vendor
+from gaitbot.bus.factory import make_probe_bus, stand_ticks_by_id
+from gaitbot.app.progress import progress
+from gaitbot.servos import common_baud_rates, max_servo_id, vendor
+
+
+def survey_shown(probe, rates, what: str) -> list:
+    """``survey`` with a progress bar on a terminal (one step a PING; a broadcast ping is one step), the rate
+    being searched and the servos found so far beside it."""
+    broadcast = probe.vendor.BROADCAST_PING.get(probe.protocol) is not None
+    per_rate = 1 if broadcast else max_servo_id(probe.backend, probe.protocol) + 1
+    found = []
+
+    def after_rate(result) -> None:
+        found.extend(result.found)
+        bar.set_postfix_str(f"{result.baudrate:,} baud done, {len(found)} found")
+
+    with progress(what, total=len(rates) * per_rate, unit="ping") as bar:
+        return survey(probe, rates, on_baud=after_rate, on_ping=lambda _servo_id: bar.update())
 
 
 def _joint_of(config, report: ServoReport):
@@ -80,9 +96,13 @@ def run(args) -> int:
         rates = common_baud_rates(backend, protocol)
     port = serial_port(config, args.port, args.dry_run)
     probe = make_probe_bus(backend, protocol, port, dry_run=args.dry_run, models=config.models_by_id,
-                           baudrate=config.bus.baudrate, reply_timeout_ms=args.reply_timeout_ms)
+                           baudrate=config.bus.baudrate, reply_timeout_ms=args.reply_timeout_ms,
+                           start_ticks=stand_ticks_by_id(config))
+    if not args.json:
+        print(f"{config.name}: scanning {backend} protocol {protocol:g} on {port} at "
+              f"{', '.join(f'{r:,}' for r in rates)} baud", flush=True)
     with probe:
-        results = survey(probe, rates)
+        results = survey_shown(probe, rates, "scan")
         reports = [describe_servo(probe, s) for r in results for s in r.found]
     rows = [_row(config, r) for r in reports]
     missing = _missing(config, rows)
@@ -92,8 +112,6 @@ def run(args) -> int:
                           "baud_rates": list(rates), "servos": rows, "missing_joints": missing,
                           "damaged_replies": {str(k): v for k, v in damaged.items()}}, indent=2))
         return 1 if missing else 0
-    print(f"{config.name}: scanned {backend} protocol {protocol:g} on {port} at {', '.join(f'{r:,}' for r in rates)} "
-          "baud")
     print(f"{'id':>3s} {'baud':>9s} {'model':11s} {'fw':>4s} {'ticks':>6s} {'joint':18s} {'angle':>7s} "
           f"{'volts':>5s} {'temp':>4s} {'load':>6s} {'torque':6s} hardware errors")
     for r in rows:

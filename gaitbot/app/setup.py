@@ -15,8 +15,10 @@ from gaitbot.app.arguments import REPLY_TIMEOUT_HELP, add_command, robot_options
 from gaitbot.app.hardware import serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_reply_timeout, load_robot
 from gaitbot.bus.base import BusError
-from gaitbot.bus.bringup import assign_id_and_baud, survey
+from gaitbot.app.scan import survey_shown
+from gaitbot.bus.bringup import assign_id_and_baud
 from gaitbot.bus.factory import make_probe_bus
+from gaitbot.robot.calibration_file import calibration_path_for
 from gaitbot.servos import baud_rates, baud_register_value, common_baud_rates, max_servo_id
 
 PROMPT = ("Connect only the servo for {joint} ({model}; it becomes id {id} at {baud:,} baud), then press Enter.")
@@ -78,7 +80,7 @@ def run(args) -> int:
                                      "its servo is the only one connected, or give --yes); nothing written")
             rates = common_baud_rates(backend, protocol, [model.name])
             print(f"{joint.name}: looking for a servo at ids 0..{_max_id(probe)} and {_rates(rates)} baud", flush=True)
-            results = survey(probe, rates)
+            results = survey_shown(probe, rates, joint.name)
             found = [s for r in results for s in r.found]
             damaged = {r.baudrate: r.damaged for r in results if r.damaged}
             if len(found) > 1 or damaged:
@@ -104,8 +106,10 @@ def run(args) -> int:
             print(f"{joint.name}: {model.name} found at id {servo.servo_id}, {servo.baudrate:,} baud; now id "
                   f"{assignment.servo_id} at {assignment.baudrate:,} baud (read back). Written: {writes}", flush=True)
             done += 1
-    print(f"{config.name}: {done} of {len(joints)} servos set up; next: gaitbot scan --robot {config.path}, then "
-          f"gaitbot calibrate --robot {config.path} -o {config.path.stem}.calibration.toml")
+    robot = args.robot or config.name
+    print(f"{config.name}: {done} of {len(joints)} servos set up; next, with every servo connected: gaitbot scan "
+          f"--robot {robot}, then gaitbot calibrate --robot {robot} (it writes "
+          f"{calibration_path_for(config.path)}, where every command finds it)")
     return 0
 
 

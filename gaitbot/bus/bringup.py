@@ -36,12 +36,13 @@ class SetupFailed(BusError):
 
 
 def survey(probe: ProbeBus, baudrates: Sequence[int], on_baud: Callable[[ProbeResult], None] | None = None,
-           ) -> list[ProbeResult]:
-    """Search the bus at each rate in turn: every servo that answers, and the damaged replies, per rate."""
+           on_ping: Callable[[int], None] | None = None) -> list[ProbeResult]:
+    """Search the bus at each rate in turn: every servo that answers, and the damaged replies, per rate
+    (``on_baud`` after each rate, ``on_ping`` after each PING: ProbeBus.search)."""
     results = []
     for rate in baudrates:
         probe.set_baudrate(rate)
-        result = probe.search()
+        result = probe.search(on_ping=on_ping)
         results.append(result)
         if on_baud is not None:
             on_baud(result)

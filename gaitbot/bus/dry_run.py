@@ -12,7 +12,7 @@ the protocol documents, not from the SDK) and answers as the servos would:
   model number and the centre tick as goal and present position);
 * sync write: stored, no status packet;
 * read / sync read: status packets with the control-table bytes; present position mirrors the last
-  goal position written (initially the model's centre tick).
+  goal position written (initially the model's centre tick, or where the robot stands: ``start_ticks``).
 
 Servos made for a bus rate (``baudrate``) answer only while the port is set to that rate, as real
 servos do (a scan at other rates finds nothing); without it they answer at any rate.
@@ -42,7 +42,8 @@ class DryRunPort:
     """
 
     def __init__(self, backend: str, protocol: float, models: Mapping[int, ServoModel],
-                 port_name: str = "mock", baudrate: int | None = None) -> None:
+                 port_name: str = "mock", baudrate: int | None = None,
+                 start_ticks: Mapping[int, int] | None = None) -> None:
         self.vendor = vendor(backend)  # ValueError for an unknown backend
         self.backend = backend
         self.protocol = float(protocol)
@@ -63,6 +64,7 @@ class DryRunPort:
         self.servo_baudrate = baudrate  # the rate the servos were set to (None: they answer at any rate)
         self.tables = {servo_id: self.initial_table(model, servo_id, baudrate)
                        for servo_id, model in self.models.items()}
+        self.stand_at(start_ticks or {})
 
     # --- PortHandler interface -------------------------------------------------------------
     def openPort(self) -> bool:  # noqa: N802 (SDK names)
@@ -154,15 +156,26 @@ class DryRunPort:
         value = baud_register_value(model.name, baudrate) if baudrate is not None else None
         if value is not None:
             table[model.control_table["Baud Rate"].address] = value
-        centre = model.centre_tick.to_bytes(model.len_goal_position, model.byte_order)
-        table[model.addr_goal_position:model.addr_goal_position + model.len_goal_position] = centre
-        table[model.addr_present_position:model.addr_present_position + model.len_present_position] = \
-            centre[:model.len_present_position]
+        DryRunPort.place(model, table, model.centre_tick)
         if model.gain is not None:  # the factory stiffness, until a session writes its own
             factory = model.gain.factory_value.to_bytes(model.gain.length, model.byte_order)
             for address in model.gain.addresses:
                 table[address:address + model.gain.length] = factory
         return table
+
+    @staticmethod
+    def place(model: ServoModel, table: bytearray, ticks: int) -> None:
+        """Put a servo at ``ticks``: its goal and present position registers."""
+        goal = int(ticks).to_bytes(model.len_goal_position, model.byte_order)
+        table[model.addr_goal_position:model.addr_goal_position + model.len_goal_position] = goal
+        table[model.addr_present_position:model.addr_present_position + model.len_present_position] = \
+            int(ticks).to_bytes(model.len_present_position, model.byte_order)
+
+    def stand_at(self, ticks: Mapping[int, int]) -> None:
+        """Servos at these ticks (servo id -> ticks) instead of their centre: where the robot stands."""
+        for servo_id, tick in ticks.items():
+            if servo_id in self.tables:
+                self.place(self.models[servo_id], self.tables[servo_id], tick)
 
     @staticmethod
     def servo_rate(model: ServoModel, table: bytearray) -> int | None:

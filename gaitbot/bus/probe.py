@@ -14,7 +14,7 @@ does; two exchanges are its own, because the SDKs offer none that fits:
   packet means one servo and a damaged one means several.
 * **one id at a time** (Dynamixel 1.0, which has no broadcast ping, and Feetech when its broadcast ping
   came back damaged): a PING per id, each waiting the reply timeout. A status packet that arrives after
-  its timeout is not lost: every byte read from the port passes a tap that notes the id of each clean
+  its timeout (SEARCH_PING_TIMEOUT_MS unless given) is not lost: every byte read from the port passes a tap that notes the id of each clean
   status packet (the SDK skips a reply whose id is not the one it asked), and those ids are pinged again
   with a long timeout.
 
@@ -26,6 +26,7 @@ packet is counted in :attr:`ProbeResult.damaged`, so bring-up can refuse a bus w
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -43,6 +44,12 @@ _BROADCAST_MS_PER_SERVO = 3.0
 _USB_LATENCY_MS = 16.0
 #: A second look at a servo that answered late, or whose answer must be sure: this long per reply.
 CONFIRM_TIMEOUT_MS = 100.0
+#: A PING of one id during a search waits this long unless the caller set a reply timeout: the SDK's 34 ms
+#: made a Protocol 1.0 scan (254 ids at six rates) take 52 s and more. A servo answers within its Return
+#: Delay Time (0.5 ms as shipped) plus the reply's bytes; a USB adapter that holds the reply back longer
+#: (a 16 ms latency timer) costs nothing either: the late reply is seen by the tap and its id asked again
+#: with CONFIRM_TIMEOUT_MS.
+SEARCH_PING_TIMEOUT_MS = 2.0
 #: A broadcast ping waits at least this long for a first reply, whatever the reply timeout: once per baud
 #: rate, and a servo missed there is a servo not found (the SDK's own window is longer still).
 FIRST_REPLY_MS = 250.0
@@ -135,26 +142,30 @@ class ProbeBus:
         self.baudrate = int(baudrate)
 
     # --- finding servos ---------------------------------------------------------------------
-    def search(self, ids: range | None = None) -> ProbeResult:
-        """Every servo answering at the current baud rate (ids: every usable id)."""
+    def search(self, ids: range | None = None, on_ping: Callable[[int], None] | None = None) -> ProbeResult:
+        """Every servo answering at the current baud rate (ids: every usable id). ``on_ping(servo_id)`` is
+        called after each PING of one id (progress; a broadcast ping calls it with the broadcast id)."""
         if self.baudrate is None:
             raise RuntimeError("set a baud rate first")
         ids = ids if ids is not None else range(0, max_servo_id(self.backend, self.protocol) + 1)
         result = ProbeResult(self.baudrate)
+        on_ping = on_ping or (lambda _servo_id: None)
         broadcast = self.vendor.BROADCAST_PING.get(self.protocol)
         if broadcast == "in turn":
             answered, result.damaged = self._broadcast_ping(all_at_once=False)
+            on_ping(wire.BROADCAST_ID)
             numbers = answered
         elif broadcast == "at once":
             answered, result.damaged = self._broadcast_ping(all_at_once=True)
+            on_ping(wire.BROADCAST_ID)
             if result.damaged or not answered:
                 numbers = {}
                 if result.damaged:  # several servos: ask them one by one
-                    numbers, result.damaged = self._ping_each(ids)
+                    numbers, result.damaged = self._ping_each(ids, on_ping)
             else:
                 numbers = answered
         else:
-            numbers, result.damaged = self._ping_each(ids)
+            numbers, result.damaged = self._ping_each(ids, on_ping)
         for servo_id in sorted(i for i in numbers if i in ids):
             number = numbers[servo_id]
             if number is None:
@@ -190,13 +201,15 @@ class ProbeBus:
             answered[frame.packet_id] = number
         return answered, damaged
 
-    def _ping_each(self, ids) -> tuple[dict[int, int | None], int]:
+    def _ping_each(self, ids, on_ping: Callable[[int], None]) -> tuple[dict[int, int | None], int]:
         answered: dict[int, int | None] = {}
         self.port.seen.clear()
         self.port.damaged = 0
+        timeout_ms = SEARCH_PING_TIMEOUT_MS if self.reply_timeout_ms is None else self.reply_timeout_ms
         for servo_id in ids:
             self._drop_stale()
-            outcome, number = self._ping_once(servo_id)
+            outcome, number = self._ping_once(servo_id, timeout_ms)
+            on_ping(servo_id)
             if outcome == "ok":
                 answered[servo_id] = number
         self._drop_stale()

@@ -18,6 +18,7 @@ from gaitbot.emulator.faults import FaultInjection
 from gaitbot.emulator.hand import ScriptedHand
 from gaitbot.emulator.heat import HeatAndSupply
 from gaitbot.emulator.instructions import MoreInstructions
+from gaitbot.emulator.state import write_state
 from gaitbot.emulator.units import ACCESS_ERROR, LAYOUTS, Servo
 from gaitbot.servos import baud_register_value, vendor, wire
 from gaitbot.servos.health import health_block
@@ -51,6 +52,7 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
         self._instruction_rate: int | None = None
         self._rng = random.Random(config.seed)
         self._registered: dict[int, tuple[int, bytes]] = {}
+        self.state_changed = False  # an EEPROM write was kept since the state file was last saved
         self.hand = config.hand
         self.hand_sample = 0
         self._hand_grabbed_s: float | None = None  # when the first torque-off came; None: not yet
@@ -63,6 +65,7 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
         if config.one_at_a_time:
             self.connect_only(0)
         self._route()
+        self.save_state()
         if config.log_path:
             joints = config.joints or {f"servo_{i}": i for i in config.models}
             self.goal_log = BusRecorder(config.log_path, robot=config.robot, joints=joints, clock=time.monotonic)
@@ -70,11 +73,21 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
                                 models=config.models or {u.servo_id: u.model for u in self.units})
 
     def _make_units(self, config: EmulatorConfig) -> list[Servo]:
-        fresh = bool(config.fresh)
-        entries = [(vendor(m.family).FACTORY_ID, m) for m in config.fresh] if fresh else list(config.models.items())
+        fresh = bool(config.fresh or config.restored)
+        if config.restored:
+            entries = [(eeprom[LAYOUTS[m.name].id_addr], m) for m, eeprom in config.restored]
+        elif fresh:
+            entries = [(vendor(m.family).FACTORY_ID, m) for m in config.fresh]
+        else:
+            entries = list(config.models.items())
         units = []
         for index, (servo_id, model) in enumerate(entries):
+            start = config.start_ticks.get(servo_id, model.centre_tick) if not config.fresh else model.centre_tick
             table = DryRunPort.initial_table(model, servo_id, None if fresh else config.baudrate)
+            DryRunPort.place(model, table, start)
+            if config.restored:  # the EEPROM as the servo kept it (its id, rate, limits ...)
+                eeprom = config.restored[index][1][:LAYOUTS[model.name].eeprom_end]
+                table[:len(eeprom)] = eeprom
             if servo_id in config.model_numbers and not fresh:  # a servo of another model behind this one's table
                 number = model.control_table["Model Number"]
                 table[number.address:number.address + number.size] = \
@@ -84,7 +97,7 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
                 table[layout.return_delay_addr] = min(254, int(round(config.return_delay_us / 2)))
             blind = not fresh and baud_register_value(model.name, config.baudrate) is None
             ambient = config.heat.ambient_c
-            units.append(Servo(index, model, table, bytearray(table[:layout.eeprom_end]), float(model.centre_tick),
+            units.append(Servo(index, model, table, bytearray(table[:layout.eeprom_end]), float(start),
                                config.temperatures_c.get(servo_id, ambient), config.loads_pct.get(servo_id, 0.0),
                                rate_blind=blind))
         return units
@@ -149,6 +162,13 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
         for unit in self.units:
             unit.connected = True
         self._route()
+
+    def save_state(self) -> None:
+        """Keep every servo's EEPROM as saved in the state file, if one was asked for (gaitbot.emulator.state)."""
+        self.state_changed = False
+        if self.config.state_path:
+            write_state(self.config.state_path, self.config.backend, self.config.protocol,
+                        [(u.model, bytes(u.saved)) for u in self.units])
 
     def power_cycle(self) -> None:
         """Power off and on: the EEPROM as saved, RAM back to its power-on values, torque off."""
@@ -276,6 +296,7 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
             if not locked:
                 end = min(layout.eeprom_end, address + len(data))
                 unit.saved[address:end] = data[:end - address]
+                self.state_changed = True  # saved once the replies are out (ServoEmulator.serve), not in their way
         self.writes.append((unit.index, servo_id, address, bytes(data), True))
         self._grab_by_hand(servo_id, address, data)
 

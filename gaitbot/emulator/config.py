@@ -82,6 +82,9 @@ class EmulatorConfig:
     voltage_sag_v_per_s: float = 0.0  # the supply falls this fast once faults are active
     imu: object | None = None  # an IMU device on the line (gaitbot.bus.imu_device.ImuDevice), answering at its id
     model_numbers: dict[int, int] = field(default_factory=dict)  # servo id -> the model number it reports
+    start_ticks: dict[int, int] = field(default_factory=dict)  # servo id -> where it is at power-on (else centre)
+    restored: tuple = ()  # (model, EEPROM bytes) per servo, from a state file: these servos instead of ``models``
+    state_path: str | None = None  # keep every servo's EEPROM in this file (gaitbot.emulator.state)
 
 
 def hand_from_ticks(path: str, rate_hz: float | None = None) -> Hand:

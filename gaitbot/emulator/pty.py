@@ -57,6 +57,11 @@ class ServoEmulator:
         with self.lock:
             return self.chain.plug_next()
 
+    def connect_all(self) -> None:
+        """Plug in every servo: the whole chain, as on the robot."""
+        with self.lock:
+            self.chain.connect_all()
+
     def line_baud(self) -> int | None:
         """The rate the driver set on its end of the pty (read from the master side), None if unknown."""
         return line_rate(self.master_fd)
@@ -93,6 +98,9 @@ class ServoEmulator:
                     due = chain.due(now_s)
                 for packet in due:
                     self._write(packet)
+                if chain.state_changed and not chain.outbox:  # the servos' EEPROM to the state file, off the line
+                    with self.lock:
+                        chain.save_state()
                 if chain.should_close(now_s):
                     self._close(f"port closed after {chain.goal_frames} goal frames (fault injection)")
                     return
@@ -112,6 +120,8 @@ class ServoEmulator:
         if self._done.is_set():
             return
         self.closed_reason = reason
+        if self.chain.state_changed:
+            self.chain.save_state()
         for fd in (self.master_fd, self.slave_fd):  # closing the master hangs up the driver's end
             try:
                 os.close(fd)

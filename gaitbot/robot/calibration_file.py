@@ -20,8 +20,9 @@ docs/file-formats.md describes it::
 
 Applied (:func:`apply_calibration`): each listed joint takes ``zero_tick`` and ``direction``; joints not
 listed keep the config's. Every problem is one line naming the file and the field (exit 2).
-Found by :func:`calibration_path_for` next to the config (``<config stem>.calibration.toml``) when no
-``--calibration FILE`` is given.
+Found by :func:`calibration_path_for` when no ``--calibration FILE`` is given: next to the config
+(``<config stem>.calibration.toml``), or for a shipped robot (whose file belongs to gaitbot, not to one build)
+in the current folder. ``gaitbot calibrate`` writes it there by default, ``gaitbot setup`` names that place.
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ from pathlib import Path
 from gaitbot.fields import FieldError, Fields, kind, read_toml
 from gaitbot.robot.config import (RobotConfig, angle_outside_servo, default_config_path,
                                   load_robot_config, resolve_config)
+from gaitbot.robot.shipped_configs import shipped_config_dirs
 
 FORMAT = "gaitbot-calibration"
 VERSION = 1
@@ -66,9 +68,15 @@ class CalibrationFile:
 
 
 def calibration_path_for(config_path: str | Path) -> Path:
-    """Where a config's own calibration lives: ``robot.toml`` -> ``robot.calibration.toml`` beside it."""
+    """Where a config's own calibration lives: ``robots/mybot.toml`` -> ``robots/mybot.calibration.toml``
+    beside it; a shipped robot's (``xl430-biped``) in the current folder, ``xl430-biped.calibration.toml``
+    (a calibration is one build's, and the shipped file is gaitbot's: not written into the package)."""
     config_path = Path(config_path)
-    return config_path.with_name(config_path.stem + SUFFIX)
+    name = config_path.stem + SUFFIX
+    shipped = {d.resolve() for d in shipped_config_dirs()}
+    if config_path.resolve().parent in shipped:
+        return Path(name)
+    return config_path.with_name(name)
 
 
 def read_calibration(path: str | Path) -> CalibrationFile:
@@ -134,7 +142,7 @@ def apply_calibration(config: RobotConfig, calibration: CalibrationFile) -> Robo
 
 def load_robot_with_calibration(robot: str | Path | None, calibration: str | Path | None = None) -> RobotConfig:
     """A robot config (a path, a shipped name, or the default robot) with its calibration applied: the file
-    given, else ``<config stem>.calibration.toml`` beside the config when it exists, else none."""
+    given, else the config's own (:func:`calibration_path_for`) when it exists, else none."""
     path = resolve_config(robot) if robot else default_config_path()
     config = load_robot_config(path)
     found = Path(calibration) if calibration else calibration_path_for(path)

@@ -6,7 +6,7 @@ where it is (a missing servo stops here, nothing written), check each servo's mo
 config, ``confirm`` torque off, torque off (the only write), ``ask`` for the zero pose and read every
 servo: those ticks are the zero ticks; then for each joint ``ask`` that it be bent in its positive
 direction and read every servo again: the sign of the joint's change is its direction, the size the range
-moved. Every step reads each servo exactly once, so a scripted hand (the emulator's, one sample per read
+moved. Joints bent at earlier steps may be held or let back; another joint that is neither is reported. Every step reads each servo exactly once, so a scripted hand (the emulator's, one sample per read
 cycle) gives the same answer whatever the timing. Torque stays off at the end.
 """
 
@@ -85,17 +85,25 @@ def calibrate_session(bus: Bus, joints: Sequence[CalibrationJoint], *, ask: Call
         ask("zero", "")
         zero = bus.read_present_ticks(ids)
         results = []
+        before = zero
         for j in joints:
             ask(j.name, words(j.name))
             bent = bus.read_present_ticks(ids)
-            results.append(_judge(j, joints, zero, bent))
+            results.append(_judge(j, joints, zero, before, bent))
+            before = bent
         return results
     finally:
         bus.close()
 
 
-def _judge(j: CalibrationJoint, joints: Sequence[CalibrationJoint], zero: dict[int, int],
+def _degrees(joint: CalibrationJoint, before: int, after: int) -> float:
+    return abs(tick_delta(joint.model, before, after)) / (joint.model.ticks_per_rad * math.pi / 180.0)
+
+
+def _judge(j: CalibrationJoint, joints: Sequence[CalibrationJoint], zero: dict[int, int], before: dict[int, int],
            bent: dict[int, int]) -> JointResult:
+    """Direction and range of ``j`` from the zero pose to ``bent``. Another joint is said to have moved only when
+    it is neither where the last step left it (held bent, as the prompt allows) nor back at zero."""
     model = j.model
     ticks_per_deg = model.ticks_per_rad * math.pi / 180.0
     delta = tick_delta(model, zero[j.id], bent[j.id])
@@ -106,10 +114,10 @@ def _judge(j: CalibrationJoint, joints: Sequence[CalibrationJoint], zero: dict[i
     notes = []
     for other in joints:
         if other.id != j.id:
-            other_deg = abs(tick_delta(other.model, zero[other.id], bent[other.id])) / (
-                other.model.ticks_per_rad * math.pi / 180.0)
-            if other_deg > OTHERS_STILL_DEG:
-                notes.append(f"{other.name} moved {other_deg:.1f} deg too while {j.name} was bent")
+            from_zero = _degrees(other, zero[other.id], bent[other.id])
+            from_before = _degrees(other, before[other.id], bent[other.id])
+            if min(from_zero, from_before) > OTHERS_STILL_DEG:
+                notes.append(f"{other.name} moved {from_before:.1f} deg too while {j.name} was bent")
     if moved_deg > j.max_deg + OTHERS_STILL_DEG:
         notes.append(f"bent {moved_deg:.1f} deg, past its configured max_deg {j.max_deg:g}: the joint reaches further "
                      "than the config lets it walk (fine), or the zero pose was not straight")

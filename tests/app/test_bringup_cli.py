@@ -94,6 +94,6 @@ def test_emulator_options_for_bring_up(tmp_path):
     for argv, words in ((["--protocol", "dxl2", "--baudrate", "500000"], "cannot run at it"),
                         (["--protocol", "dxl2", "--one-at-a-time"], "needs --factory-fresh"),
                         (["--protocol", "dxl2", "--load", "1:150"], "within 0..100"),
-                        (["--protocol", "dxl2", "--hand-ticks", str(hand), "--hand", str(hand)], "not both")):
+                        (["--protocol", "dxl2", "--hand-ticks", str(hand), "--hand", str(hand)], "one of --hand")):
         with pytest.raises(ValueError, match=words):
             parse(*argv)

@@ -129,7 +129,8 @@ def test_scan_with_a_missing_servo_exits_1(capsys, tmp_path):
     ``missing:`` line per configured joint that did not answer, docs/bring-up.md), not a MISSING table row."""
     cfg = CONFIG_DIR / "xl430-biped.toml"
     with emulator_for(cfg, tmp_path / "log.jsonl", se.Faults(silent={3})) as chain:
-        code, out, _ = run_cli(capsys, "scan", "--robot", cfg, "--port", chain.path)
+        # a 20 ms quiet window ends each rate's broadcast ping (the SDK's own window is 1.4 s at 57,600 baud)
+        code, out, _ = run_cli(capsys, "scan", "--robot", cfg, "--port", chain.path, "--reply-timeout-ms", "20")
     assert code == 1
     assert "missing: ankle_pitch_left (id 3, XL430-W250, 1,000,000 baud) did not answer" in out
     assert not re.search(r"(?m)^\s+3 ", out)  # and not listed among the servos that answered

@@ -67,15 +67,16 @@ def test_dry_run_recording_matches_generate(config_path, tmp_path, capsys):
     assert abs(periods.mean() - 1 / 60) < 0.01 / 60
     trajectory = Trajectory.load(csv)
     # Before the walk the session ramps every servo from where it is to the walk's first pose. The mock's
-    # servos start at their model's centre tick (gaitbot/bus/dry_run.py), and a pose at most 1 tick away is
-    # not worth a ramp (gaitbot/stream/ramps.py): so no ramp where the first pose is the centre (zero_tick
-    # at the centre, as on the pitch-only robots), a ramp where it is not (bioloid: its zero_ticks sit off
-    # the centre by the legs' dog-leg offsets).
+    # servos start where the robot stands (gaitbot/bus/factory.py: walking joints at 0 deg, held joints at
+    # their hold_deg, in the config's ticks), and a pose at most 1 tick away is not worth a ramp
+    # (gaitbot/stream/ramps.py): so a ramp only where the walk's first pose is not the stand pose.
     first_deg = {j.name: j.hold_deg for j in config.held_joints}
     first_deg.update({j.name: trajectory.angles_deg[0, c] for c, j in enumerate(config.walking_joints)})
     first_ticks = np.array([j.zero_tick + j.direction * first_deg[j.name] * j.model.ticks_per_rad * math.pi / 180
                             for j in config.joints])
-    centre_ticks = np.array([j.model.centre_tick for j in config.joints])
+    stand_deg = {j.name: (j.hold_deg if j in config.held_joints else 0.0) for j in config.joints}
+    centre_ticks = np.rint([j.zero_tick + j.direction * stand_deg[j.name] * j.model.ticks_per_rad * math.pi / 180
+                            for j in config.joints])  # where the mock's servos start
     ramp_frames = len(frames) - len(trajectory)
     assert (ramp_frames > 0) == (np.abs(np.rint(first_ticks) - centre_ticks).max() > 1), ramp_frames
     if ramp_frames:
@@ -84,7 +85,7 @@ def test_dry_run_recording_matches_generate(config_path, tmp_path, capsys):
         towards = np.sign(np.rint(first_ticks) - centre_ticks)  # 0: a servo already there stays
         moves = np.diff(np.vstack([centre_ticks, ramp]), axis=0)
         assert (moves * towards >= 0).all() and (moves[:, towards == 0] == 0).all(), \
-            "the ramp moves every servo from the centre straight to the first pose"
+            "the ramp moves every servo from the stand pose straight to the first pose"
     # after it, decoded angles equal generate's for the same plan to within one tick
     for col, joint in enumerate(config.walking_joints):
         per_deg = joint.model.ticks_per_rad * math.pi / 180

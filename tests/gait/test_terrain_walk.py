@@ -143,10 +143,14 @@ def sweep(name):
     }
 
 
-CASES = [(name, case) for name in ROBOTS for case in sweep(name)]
+#: The default robot's sweep runs in the quick loop; the other robots' (each robot's stated envelope figures
+#: walked again, a minute on two cores) in the slow set, which the full run and CI include.
+QUICK_ROBOT = "xl430-biped"
+CASES = [pytest.param(name, case, id=f"{name}: {case}", marks=[] if name == QUICK_ROBOT else [pytest.mark.slow])
+         for name in ROBOTS for case in sweep(name)]
 
 
-@pytest.mark.parametrize("name, case", CASES, ids=[f"{n}: {c}" for n, c in CASES])
+@pytest.mark.parametrize("name, case", CASES)
 def test_courses_inside_the_envelope_walk_cleanly(name, case):
     rb = robot(name)
     treads, end = sweep(name)[case]
@@ -160,13 +164,29 @@ def examples_for(name: str) -> Path:
     return EXAMPLES if name == "xl430-biped" else EXAMPLES / name
 
 
-@pytest.mark.parametrize("name", ROBOTS)
-@pytest.mark.parametrize("example", ["kerb", "stairs", "ditch"])
+_EXAMPLE_WALKS: dict[tuple[str, str], tuple] = {}
+
+
+def example_walk(name: str, example: str):
+    """(course, walk, settings) of a shipped example course on a robot, planned once per test process: the
+    default robot's stairs are judged below and examined by the tests of ``stairs_walk`` (one xdist group)."""
+    key = (name, example)
+    if key not in _EXAMPLE_WALKS:
+        course = load_course(examples_for(name) / f"{example}.toml")
+        _EXAMPLE_WALKS[key] = (course, *robot(name).walk(course))
+    return _EXAMPLE_WALKS[key]
+
+
+def _grouped(name: str, example: str):
+    """The default robot's stairs run on the worker of the ``stairs_walk`` tests, which reuse its walk."""
+    marks = [pytest.mark.xdist_group("stairs-xl430")] if (name, example) == ("xl430-biped", "stairs") else []
+    return pytest.param(name, example, marks=marks, id=f"{example}-{name}")
+
+
+@pytest.mark.parametrize("name, example", [_grouped(n, e) for e in ("kerb", "stairs", "ditch") for n in ROBOTS])
 def test_examples_walk_cleanly_on_every_robot(name, example):
-    course = load_course(examples_for(name) / f"{example}.toml")
-    rb = robot(name)
-    walk, settings = rb.walk(course)
-    judge(rb, walk, settings, course.terrain.treads)
+    course, walk, settings = example_walk(name, example)
+    judge(robot(name), walk, settings, course.terrain.treads)
 
 
 @pytest.mark.parametrize("name", ROBOTS)
@@ -186,10 +206,10 @@ def test_examples_are_meaningful_for_their_robot(name):
 
 @pytest.fixture(scope="module")
 def stairs_walk():
-    course = load_course(EXAMPLES / "stairs.toml")
-    return course, *robot("xl430-biped").walk(course)
+    return example_walk("xl430-biped", "stairs")  # examples_for("xl430-biped") is EXAMPLES
 
 
+@pytest.mark.xdist_group("stairs-xl430")
 def test_stairs_up_and_down_are_one_walk(stairs_walk):
     course, walk, _ = stairs_walk
     heights = [s.height_m for s in walk.steps]
@@ -198,6 +218,7 @@ def test_stairs_up_and_down_are_one_walk(stairs_walk):
     assert walk.trajectory.root_m[-1, 0] == pytest.approx(walk.steps[-1].foothold_m + rb.geometry.heel_back, abs=1e-6)
 
 
+@pytest.mark.xdist_group("stairs-xl430")
 def test_flat_steps_are_the_boulic_walkers(stairs_walk):
     _, walk, _ = stairs_walk
     flat = [s for s in walk.steps if s.method == "flat"]
@@ -207,6 +228,7 @@ def test_flat_steps_are_the_boulic_walkers(stairs_walk):
     assert inner.count("StepSegment") == len(flat)
 
 
+@pytest.mark.xdist_group("stairs-xl430")
 def test_grid_search_beats_the_middle_and_nears_brute_force(stairs_walk):
     _, walk, _ = stairs_walk
     reports = walk.search_reports
