@@ -221,15 +221,21 @@ def balanced_plan(source: GaitSource, steps, max_step_m: float | None = None) ->
 
 
 def speed_fit_note(plan: BalancedPlan) -> str | None:
-    """One line when a balanced walk's settings were relaxed to fit the servos' speed (else None)."""
+    """One line when a balanced walk's settings were relaxed to keep the servos' limits with the planning
+    margin (PLANNED_SHARE, gaitbot.robot.motion_margin), or could not be (else None)."""
     fit = plan.fit
-    if fit.relaxed == 0:
+    if fit.relaxed == 0 and fit.fits:
         return None
     b, g = fit.balance, fit.gait
-    return (f"the servos' max_velocity_dps ({fit.limit_dps:g}) needed a gentler walk at this cycle and step: crouch "
-            f"{b.crouch_knee_deg:g} deg, double support {100 * b.double_support_share:g}%, progression done at "
-            f"{100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm (peak "
-            f"{fit.peak_dps:.0f} deg/s; docs/balance.md)")
+    settings = (f"crouch {b.crouch_knee_deg:g} deg, double support {100 * b.double_support_share:g}%, progression "
+                f"done at {100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm")
+    peak = f"peak {fit.peak_dps:.0f} deg/s, {100 * fit.peak_share:.0f}% of a limit"
+    if not fit.fits:
+        return (f"no gentler walk keeps the servos within {100 * fit.target_share:g}% of their velocity and "
+                f"acceleration limits (the margin planned walks keep) at this cycle and step: walking with "
+                f"{settings} ({peak}; a longer --cycle or shorter steps fit; docs/checking.md)")
+    return (f"the servos' limits (max_velocity_dps {fit.limit_dps:g}, kept within {100 * fit.target_share:g}%) needed "
+            f"a gentler walk at this cycle and step: {settings} ({peak}; docs/balance.md)")
 
 
 def terrain_walk(source: GaitSource, course_path: str, clearance_m: float | None = None):
