@@ -31,6 +31,7 @@ from gaitbot.gait.walk_segments import GaitGenerationError
 from gaitbot.gait.walker import WalkSettings, make_context, plan_walk, trajectory_of
 from gaitbot.robot.balanced_walk import BalancedPlan, balanced_gait_settings, plan_balanced
 from gaitbot.robot.config import RobotConfig
+from gaitbot.robot.planar_fit import fit_cycle
 from gaitbot.robot.walk_settings import GaitSource, terrain_settings
 
 
@@ -104,13 +105,22 @@ def plan_planar(request: WalkRequest) -> PlannedWalk:
     """``--steps`` / ``--distance`` on a planar robot (or a leg given on the command line): the Boulic walker."""
     source, args = request.source, request.options
     steps = step_lengths(args, source)
-    try:
-        walker = plan_walk(source.geometry, steps, source.settings)
+
+    def plan(settings):
+        walker = plan_walk(source.geometry, steps, settings)
+        return walker, pelvis_root(source, trajectory_of(walker))
+
+    try:  # the cycle stretched where the servos' limits need it (gaitbot.robot.planar_fit)
+        fit = fit_cycle(source.robot, source.settings, plan)
     except StepLengthError as exc:
         raise UsageError(str(exc)) from None
     except GaitGenerationError as exc:
         raise UsageError(f"{leg_origin(args, source)}: {exc}") from None
-    trajectory = pelvis_root(source, trajectory_of(walker))
+    if fit.note():
+        print(f"note: {fit.note()}", file=sys.stderr)
+    walker, trajectory = fit.plan, fit.trajectory
+    if fit.stretched:
+        source = replace(source, settings=replace(source.settings, cycle_s=fit.cycle_s))
     return PlannedWalk(source, trajectory, trajectory, tuple(walker.heel_strikes), tuple(walker.planned_steps), walker)
 
 
@@ -132,8 +142,16 @@ def plan_terrain(request: WalkRequest) -> PlannedWalk:
     if source.balanced:
         raise UsageError(f"--terrain: robot {source.robot.name} walks with the balanced walker, which walks "
                          "on the flat only (terrain courses are walked by the planar walker)")
-    walk = terrain_walk(source, args.terrain, getattr(args, "clearance", None))
-    trajectory = pelvis_root(source, walk.trajectory)
+    def plan(settings):
+        walk = terrain_walk(replace(source, settings=settings), args.terrain, getattr(args, "clearance", None))
+        return walk, pelvis_root(source, walk.trajectory)
+
+    fit = fit_cycle(source.robot, source.settings, plan)  # the cycle stretched where the servos' limits need it
+    if fit.note():
+        print(f"note: {fit.note()}", file=sys.stderr)
+    walk, trajectory = fit.plan, fit.trajectory
+    if fit.stretched:
+        source = replace(source, settings=replace(source.settings, cycle_s=fit.cycle_s))
     return PlannedWalk(source, trajectory, trajectory, tuple(walk.heel_strikes), tuple(walk.planned_steps), walk)
 
 
@@ -229,7 +247,7 @@ def speed_fit_note(plan: BalancedPlan) -> str | None:
     b, g = fit.balance, fit.gait
     settings = (f"crouch {b.crouch_knee_deg:g} deg, double support {100 * b.double_support_share:g}%, progression "
                 f"done at {100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm")
-    peak = f"peak {fit.peak_dps:.0f} deg/s, {100 * fit.peak_share:.0f}% of a limit"
+    peak = f"peak {fit.peak_dps:.0f} deg/s, {100 * fit.peak_share:.1f}% of a limit"
     if not fit.fits:
         return (f"no gentler walk keeps the servos within {100 * fit.target_share:g}% of their velocity and "
                 f"acceleration limits (the margin planned walks keep) at this cycle and step: walking with "

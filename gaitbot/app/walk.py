@@ -21,7 +21,7 @@ from gaitbot.app.sim_options import add_sim_model_options, check_sim_model, fore
 from gaitbot.app.view_options import add_view_options, open_view
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.recording import BusRecorder, RecordingFailed
-from gaitbot.check.preflight import preflight
+from gaitbot.check.preflight import LimitBroken, preflight  # noqa: F401 (LimitBroken: walk's refusal)
 from gaitbot.errors import UserError
 from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
 from gaitbot.robot.gains import gain_notes, gain_writes
@@ -32,14 +32,6 @@ from gaitbot.sim.video import check_video_path
 from gaitbot.stream.clock import MonotonicClock, VirtualClock
 from gaitbot.stream.health import HealthMonitor
 from gaitbot.stream.session import SessionLimits, WalkSession
-
-
-class LimitBroken(UserError):
-    """The walk breaks a limit of the robot (or would tip it over): refused before anything moves, in one line.
-    The check failed, as ``gaitbot check`` fails on the same file: exit 1 (docs/command-line.md), not 2 (the
-    input is readable)."""
-
-    exit_status = 1
 
 
 def _status(bar, strikes, rate_hz: float, health: HealthMonitor):
