@@ -11,7 +11,8 @@ import math
 import sys
 
 from gaitbot.app.arguments import add_command, bus_options, check_walk_source, walk_options
-from gaitbot.app.feel_options import add_feedback_option, fall_dict, fall_line, feedback_mode, make_feedback
+from gaitbot.app.feel_options import (add_feedback_option, fall_dict, fall_line, feedback_choice, feedback_mode,
+                                      make_feedback)
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option, load_robot
 from gaitbot.app.planned_walk import PlannedWalk, planned_walk
@@ -91,6 +92,7 @@ def run(args) -> int:
     check_reply_timeout(args.reply_timeout_ms)
     config = load_robot(args.robot, getattr(args, "calibration", None))
     check_rate_option(config, args.rate)
+    feedback_choice(args, config)  # refused here, before any note (the open-loop note comes once all is checked)
     walk = planned_walk(args, config)
     report = preflight(config, walk.goals, on_boom=args.boom, planned=walk.planned)
     if not report.ok:
