@@ -151,8 +151,14 @@ def plan_balanced(config: RobotConfig, step_lengths, gait: BalancedGaitSettings 
     gait = gait or balanced_gait_settings(config)
     options = dict(limits_rad=leg_limits_rad(config), kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
     if speed_fit:
-        fit = fit_to_servo_speed(config.body, gait, config.balance, velocity_limit_dps(config), step_lengths,
-                                 measure=motion_measure(config), share=PLANNED_SHARE, **options)
+        # Fitted first for a steady walk at the gait's longest step, so that every walk of that longest step
+        # walks with the same settings (a family of walks: eigen-gaits are fitted to them), then for the
+        # steps asked, from those settings on.
+        fit_options = dict(measure=motion_measure(config), share=PLANNED_SHARE, **options)
+        limit = velocity_limit_dps(config)
+        steady = fit_to_servo_speed(config.body, gait, config.balance, limit, **fit_options)
+        fit = fit_to_servo_speed(config.body, gait, config.balance, limit, step_lengths, first=steady.relaxed,
+                                 **fit_options)
         return BalancedPlan(fit.walk, fit, fit.walker)
     walker = plan_balanced_walk(config.body, step_lengths, gait, config.balance, **options)
     walk = walk_of(walker)

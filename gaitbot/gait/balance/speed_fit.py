@@ -70,13 +70,14 @@ def candidates(gait: BalancedGaitSettings, balance: BalanceSettings):
 
 
 def fit_to_servo_speed(body: BodyModel, gait: BalancedGaitSettings, balance: BalanceSettings, limit_dps: float,
-                       steps=None, *, measure=None, share: float = 1.0, **options) -> SpeedFit:
+                       steps=None, *, measure=None, share: float = 1.0, first: int = 0, **options) -> SpeedFit:
     """The first candidate whose walk (``steps``; default a steady walk at ``gait.max_step_m``) keeps every
     leg joint's planned angle and goal at or under ``share`` of its limits; ``options`` go to the walker
     (limits, stiffness). ``measure(q_rad, rate_hz) -> (share of the limits, peak deg/s)`` of (N, 12) leg
     angles measures a walk (default: the peak speed over ``limit_dps``, gaitbot.robot.balanced_walk gives the
-    robot's, gaitbot.robot.joint_motion). A candidate the joint limits refuse is skipped; if every one is
-    refused, the first refusal is raised."""
+    robot's, gaitbot.robot.joint_motion). Candidates are tried from index ``first`` on (a walk of one family
+    starts where its steady walk's fit ended). A candidate the joint limits refuse is skipped; if every one
+    is refused, the first refusal is raised."""
     if measure is None:
         def measure(q_rad, rate_hz):
             peak_dps = peak_joint_speed_dps(q_rad, rate_hz)
@@ -84,7 +85,7 @@ def fit_to_servo_speed(body: BodyModel, gait: BalancedGaitSettings, balance: Bal
 
     steps = [gait.max_step_m] * PROBE_STEPS if steps is None else list(steps)
     fit, best, refused = None, None, None
-    for i, (b, g) in enumerate(candidates(gait, balance)):
+    for i, (b, g) in list(enumerate(candidates(gait, balance)))[first:]:
         try:
             walker = plan_balanced_walk(body, steps, g, b, **options)
             walk = walk_of(walker)
