@@ -151,14 +151,15 @@ def plan_balanced(config: RobotConfig, step_lengths, gait: BalancedGaitSettings 
     gait = gait or balanced_gait_settings(config)
     options = dict(limits_rad=leg_limits_rad(config), kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
     if speed_fit:
-        # Fitted first for a steady walk at the gait's longest step, so that every walk of that longest step
-        # walks with the same settings (a family of walks: eigen-gaits are fitted to them), then for the
-        # steps asked, from those settings on.
+        # A walk of steady steps is fitted from the settings of the steady walk at the gait's longest step
+        # on, so that steady walks of any length under one longest step walk with the same settings (a
+        # family: eigen-gaits are fitted to them); other walks (varied steps) for their own steps.
         fit_options = dict(measure=motion_measure(config), share=PLANNED_SHARE, **options)
         limit = velocity_limit_dps(config)
-        steady = fit_to_servo_speed(config.body, gait, config.balance, limit, **fit_options)
-        fit = fit_to_servo_speed(config.body, gait, config.balance, limit, step_lengths, first=steady.relaxed,
-                                 **fit_options)
+        first = 0
+        if len(set(step_lengths)) == 1:  # a steady walk: one family with the steady walk of its longest step
+            first = fit_to_servo_speed(config.body, gait, config.balance, limit, **fit_options).relaxed
+        fit = fit_to_servo_speed(config.body, gait, config.balance, limit, step_lengths, first=first, **fit_options)
         return BalancedPlan(fit.walk, fit, fit.walker)
     walker = plan_balanced_walk(config.body, step_lengths, gait, config.balance, **options)
     walk = walk_of(walker)
