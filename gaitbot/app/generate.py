@@ -42,6 +42,7 @@ def run(args) -> int:
     walk = planned_walk(args)
     trajectory = walk.goals if getattr(args, "goals", False) else walk.planned
     write_output(out, trajectory.save)
+    walk.say_notes()
     print(f"wrote {out} for {walked_by(walk.source)}: {len(trajectory)} frames, {trajectory.t_s[-1]:.2f} s, "
           f"{len(walk.heel_strikes)} heel strikes, {trajectory.root_m[-1, 0] - trajectory.root_m[0, 0]:.4f} m")
     refuse_what_walk_refuses(walk, out, getattr(args, "goals", False))

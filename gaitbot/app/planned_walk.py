@@ -63,6 +63,13 @@ class PlannedWalk:
     heel_strikes: tuple
     planned_steps: tuple
     plan: object
+    notes: tuple[str, ...] = ()  # what the planner had to change or could not keep (said once all checks passed)
+
+    def say_notes(self) -> None:
+        """The planner's notes on stderr, one ``note:`` line each: a command says them once its checks passed,
+        so that a refusal stays one line."""
+        for note in self.notes:
+            print(f"note: {note}", file=sys.stderr)
 
     @property
     def rate_hz(self) -> float:
@@ -116,12 +123,11 @@ def plan_planar(request: WalkRequest) -> PlannedWalk:
         raise UsageError(str(exc)) from None
     except GaitGenerationError as exc:
         raise UsageError(f"{leg_origin(args, source)}: {exc}") from None
-    if fit.note():
-        print(f"note: {fit.note()}", file=sys.stderr)
     walker, trajectory = fit.plan, fit.trajectory
     if fit.stretched:
         source = replace(source, settings=replace(source.settings, cycle_s=fit.cycle_s))
-    return PlannedWalk(source, trajectory, trajectory, tuple(walker.heel_strikes), tuple(walker.planned_steps), walker)
+    return PlannedWalk(source, trajectory, trajectory, tuple(walker.heel_strikes), tuple(walker.planned_steps), walker,
+                       _notes(fit.note()))
 
 
 def plan_balanced_walk(request: WalkRequest) -> PlannedWalk:
@@ -129,11 +135,8 @@ def plan_balanced_walk(request: WalkRequest) -> PlannedWalk:
     (gaitbot.gait.balance.speed_fit; said in a note when the walk had to be gentler)."""
     source, args = request.source, request.options
     plan = balanced_plan(source, step_lengths(args, source), args.max_step)
-    note = speed_fit_note(plan)
-    if note:
-        print(f"note: {note}", file=sys.stderr)
     return PlannedWalk(source, plan.walk.trajectory(goals=True), plan.walk.trajectory(), tuple(plan.heel_strikes),
-                       tuple(plan.planned_steps), plan)
+                       tuple(plan.planned_steps), plan, _notes(speed_fit_note(plan)))
 
 
 def plan_terrain(request: WalkRequest) -> PlannedWalk:
@@ -147,12 +150,11 @@ def plan_terrain(request: WalkRequest) -> PlannedWalk:
         return walk, pelvis_root(source, walk.trajectory)
 
     fit = fit_cycle(source.robot, source.settings, plan)  # the cycle stretched where the servos' limits need it
-    if fit.note():
-        print(f"note: {fit.note()}", file=sys.stderr)
     walk, trajectory = fit.plan, fit.trajectory
     if fit.stretched:
         source = replace(source, settings=replace(source.settings, cycle_s=fit.cycle_s))
-    return PlannedWalk(source, trajectory, trajectory, tuple(walk.heel_strikes), tuple(walk.planned_steps), walk)
+    return PlannedWalk(source, trajectory, trajectory, tuple(walk.heel_strikes), tuple(walk.planned_steps), walk,
+                       _notes(fit.note()))
 
 
 def plan_trajectory_file(request: WalkRequest) -> PlannedWalk:
@@ -196,6 +198,10 @@ PLANNERS: dict[str, Callable[[WalkRequest], PlannedWalk]] = {
 
 
 # --------------------------------------------------------------------------- what the sources share
+
+def _notes(*notes: str | None) -> tuple[str, ...]:
+    return tuple(n for n in notes if n)
+
 
 @dataclass(frozen=True)
 class FileWalk:

@@ -120,6 +120,7 @@ def run(args) -> int:
     if getattr(args, "demo", False):  # said once every input was found good: a refusal stays one line (exit 2)
         print(f"note: no --steps, --distance, --terrain or --trajectory: walking the demo, --distance "
               f"{args.distance:g}", file=sys.stderr)
+    walk.say_notes()  # the planner's (a gentler or slower walk than asked), now that every check passed
     for note in gain_notes(config):
         print(f"note: {note}", file=sys.stderr)
     health = HealthMonitor.for_robot(config, _warn_line, clock.now)
