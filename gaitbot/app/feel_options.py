@@ -15,15 +15,24 @@ def add_feedback_option(p) -> None:
                    "robot's [imu] allows (docs/feedback.md). A fall the IMU notices stops the walk (exit 1)")
 
 
-def feedback_mode(args, config) -> str:
-    """The mode asked for, or the robot's best; a robot without an IMU walks open loop and says so once."""
+def feedback_choice(args, config) -> str:
+    """The mode asked for, or the robot's best; ``--feedback`` other than none on a robot without an IMU is
+    refused (one line, exit 2). Says nothing else: call it with the other input checks, before any note."""
     asked = getattr(args, "feedback", None)
     if not config.imu.present:
         if asked not in (None, "none"):
             raise UsageError(f"--feedback {asked}: robot {config.name} has no IMU ([imu] source = \"none\")")
-        print(f"note: robot {config.name} has no IMU ([imu]): walking open loop", file=sys.stderr)
         return "none"
     return asked or "full"
+
+
+def feedback_mode(args, config) -> str:
+    """``feedback_choice``; a robot without an IMU walks open loop and says so once (call it once every
+    check has passed: a refusal stays one line)."""
+    mode = feedback_choice(args, config)
+    if not config.imu.present:
+        print(f"note: robot {config.name} has no IMU ([imu]): walking open loop", file=sys.stderr)
+    return mode
 
 
 def make_feedback(config, mode: str, bus, clock, period_s: float):

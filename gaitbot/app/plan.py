@@ -26,6 +26,7 @@ def check_arguments(parser, args) -> None:
 
 def run(args) -> int:
     walk = planned_walk(args)
+    walk.say_notes()
     if getattr(args, "terrain", None) is not None:
         return _plan_terrain(args, walk)
     source = walk.source

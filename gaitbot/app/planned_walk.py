@@ -31,6 +31,7 @@ from gaitbot.gait.walk_segments import GaitGenerationError
 from gaitbot.gait.walker import WalkSettings, make_context, plan_walk, trajectory_of
 from gaitbot.robot.balanced_walk import BalancedPlan, balanced_gait_settings, plan_balanced
 from gaitbot.robot.config import RobotConfig
+from gaitbot.robot.planar_fit import fit_cycle
 from gaitbot.robot.walk_settings import GaitSource, terrain_settings
 
 
@@ -62,6 +63,13 @@ class PlannedWalk:
     heel_strikes: tuple
     planned_steps: tuple
     plan: object
+    notes: tuple[str, ...] = ()  # what the planner had to change or could not keep (said once all checks passed)
+
+    def say_notes(self) -> None:
+        """The planner's notes on stderr, one ``note:`` line each: a command says them once its checks passed,
+        so that a refusal stays one line."""
+        for note in self.notes:
+            print(f"note: {note}", file=sys.stderr)
 
     @property
     def rate_hz(self) -> float:
@@ -104,14 +112,22 @@ def plan_planar(request: WalkRequest) -> PlannedWalk:
     """``--steps`` / ``--distance`` on a planar robot (or a leg given on the command line): the Boulic walker."""
     source, args = request.source, request.options
     steps = step_lengths(args, source)
-    try:
-        walker = plan_walk(source.geometry, steps, source.settings)
+
+    def plan(settings):
+        walker = plan_walk(source.geometry, steps, settings)
+        return walker, pelvis_root(source, trajectory_of(walker))
+
+    try:  # the cycle stretched where the servos' limits need it (gaitbot.robot.planar_fit)
+        fit = fit_cycle(source.robot, source.settings, plan)
     except StepLengthError as exc:
         raise UsageError(str(exc)) from None
     except GaitGenerationError as exc:
         raise UsageError(f"{leg_origin(args, source)}: {exc}") from None
-    trajectory = pelvis_root(source, trajectory_of(walker))
-    return PlannedWalk(source, trajectory, trajectory, tuple(walker.heel_strikes), tuple(walker.planned_steps), walker)
+    walker, trajectory = fit.plan, fit.trajectory
+    if fit.stretched:
+        source = replace(source, settings=replace(source.settings, cycle_s=fit.cycle_s))
+    return PlannedWalk(source, trajectory, trajectory, tuple(walker.heel_strikes), tuple(walker.planned_steps), walker,
+                       _notes(fit.note()))
 
 
 def plan_balanced_walk(request: WalkRequest) -> PlannedWalk:
@@ -119,11 +135,8 @@ def plan_balanced_walk(request: WalkRequest) -> PlannedWalk:
     (gaitbot.gait.balance.speed_fit; said in a note when the walk had to be gentler)."""
     source, args = request.source, request.options
     plan = balanced_plan(source, step_lengths(args, source), args.max_step)
-    note = speed_fit_note(plan)
-    if note:
-        print(f"note: {note}", file=sys.stderr)
     return PlannedWalk(source, plan.walk.trajectory(goals=True), plan.walk.trajectory(), tuple(plan.heel_strikes),
-                       tuple(plan.planned_steps), plan)
+                       tuple(plan.planned_steps), plan, _notes(speed_fit_note(plan)))
 
 
 def plan_terrain(request: WalkRequest) -> PlannedWalk:
@@ -132,9 +145,16 @@ def plan_terrain(request: WalkRequest) -> PlannedWalk:
     if source.balanced:
         raise UsageError(f"--terrain: robot {source.robot.name} walks with the balanced walker, which walks "
                          "on the flat only (terrain courses are walked by the planar walker)")
-    walk = terrain_walk(source, args.terrain, getattr(args, "clearance", None))
-    trajectory = pelvis_root(source, walk.trajectory)
-    return PlannedWalk(source, trajectory, trajectory, tuple(walk.heel_strikes), tuple(walk.planned_steps), walk)
+    def plan(settings):
+        walk = terrain_walk(replace(source, settings=settings), args.terrain, getattr(args, "clearance", None))
+        return walk, pelvis_root(source, walk.trajectory)
+
+    fit = fit_cycle(source.robot, source.settings, plan)  # the cycle stretched where the servos' limits need it
+    walk, trajectory = fit.plan, fit.trajectory
+    if fit.stretched:
+        source = replace(source, settings=replace(source.settings, cycle_s=fit.cycle_s))
+    return PlannedWalk(source, trajectory, trajectory, tuple(walk.heel_strikes), tuple(walk.planned_steps), walk,
+                       _notes(fit.note()))
 
 
 def plan_trajectory_file(request: WalkRequest) -> PlannedWalk:
@@ -179,6 +199,10 @@ PLANNERS: dict[str, Callable[[WalkRequest], PlannedWalk]] = {
 
 # --------------------------------------------------------------------------- what the sources share
 
+def _notes(*notes: str | None) -> tuple[str, ...]:
+    return tuple(n for n in notes if n)
+
+
 @dataclass(frozen=True)
 class FileWalk:
     """A trajectory file walked as it is (``walk --trajectory``): its heel strikes stand for the plan."""
@@ -221,15 +245,21 @@ def balanced_plan(source: GaitSource, steps, max_step_m: float | None = None) ->
 
 
 def speed_fit_note(plan: BalancedPlan) -> str | None:
-    """One line when a balanced walk's settings were relaxed to fit the servos' speed (else None)."""
+    """One line when a balanced walk's settings were relaxed to keep the servos' limits with the planning
+    margin (PLANNED_SHARE, gaitbot.robot.motion_margin), or could not be (else None)."""
     fit = plan.fit
-    if fit.relaxed == 0:
+    if fit.relaxed == 0 and fit.fits:
         return None
     b, g = fit.balance, fit.gait
-    return (f"the servos' max_velocity_dps ({fit.limit_dps:g}) needed a gentler walk at this cycle and step: crouch "
-            f"{b.crouch_knee_deg:g} deg, double support {100 * b.double_support_share:g}%, progression done at "
-            f"{100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm (peak "
-            f"{fit.peak_dps:.0f} deg/s; docs/balance.md)")
+    settings = (f"crouch {b.crouch_knee_deg:g} deg, double support {100 * b.double_support_share:g}%, progression "
+                f"done at {100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm")
+    peak = f"peak {fit.peak_dps:.0f} deg/s, {100 * fit.peak_share:.1f}% of a limit"
+    if not fit.fits:
+        return (f"no gentler walk keeps the servos within {100 * fit.target_share:g}% of their velocity and "
+                f"acceleration limits (the margin planned walks keep) at this cycle and step: walking with "
+                f"{settings} ({peak}; a longer --cycle or shorter steps fit; docs/checking.md)")
+    return (f"the servos' limits (max_velocity_dps {fit.limit_dps:g}, kept within {100 * fit.target_share:g}%) needed "
+            f"a gentler walk at this cycle and step: {settings} ({peak}; docs/balance.md)")
 
 
 def terrain_walk(source: GaitSource, course_path: str, clearance_m: float | None = None):

@@ -11,7 +11,8 @@ import math
 import sys
 
 from gaitbot.app.arguments import add_command, bus_options, check_walk_source, walk_options
-from gaitbot.app.feel_options import add_feedback_option, fall_dict, fall_line, feedback_mode, make_feedback
+from gaitbot.app.feel_options import (add_feedback_option, fall_dict, fall_line, feedback_choice, feedback_mode,
+                                      make_feedback)
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.file_robot import robot_for_walk
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option
@@ -22,7 +23,7 @@ from gaitbot.app.sim_options import add_sim_model_options, check_sim_model, fore
 from gaitbot.app.view_options import add_view_options, open_view
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.recording import BusRecorder, RecordingFailed
-from gaitbot.check.preflight import preflight
+from gaitbot.check.preflight import LimitBroken, preflight  # noqa: F401 (LimitBroken: walk's refusal)
 from gaitbot.errors import UserError
 from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
 from gaitbot.robot.calibration_file import sent_calibration
@@ -34,14 +35,6 @@ from gaitbot.sim.video import check_video_path
 from gaitbot.stream.clock import MonotonicClock, VirtualClock
 from gaitbot.stream.health import HealthMonitor
 from gaitbot.stream.session import SessionLimits, WalkSession
-
-
-class LimitBroken(UserError):
-    """The walk breaks a limit of the robot (or would tip it over): refused before anything moves, in one line.
-    The check failed, as ``gaitbot check`` fails on the same file: exit 1 (docs/command-line.md), not 2 (the
-    input is readable)."""
-
-    exit_status = 1
 
 
 def _status(bar, strikes, rate_hz: float, health: HealthMonitor):
@@ -102,6 +95,7 @@ def run(args) -> int:
     check_reply_timeout(args.reply_timeout_ms)
     config = robot_for_walk(args)
     check_rate_option(config, args.rate)
+    feedback_choice(args, config)  # refused here, before any note (the open-loop note comes once all is checked)
     walk = planned_walk(args, config)
     report = preflight(config, walk.goals, on_boom=args.boom, planned=walk.planned)
     if not report.ok:
@@ -129,6 +123,7 @@ def run(args) -> int:
     if getattr(args, "demo", False):  # said once every input was found good: a refusal stays one line (exit 2)
         print(f"note: no --steps, --distance, --terrain or --trajectory: walking the demo, --distance "
               f"{args.distance:g}", file=sys.stderr)
+    walk.say_notes()  # the planner's (a gentler or slower walk than asked), now that every check passed
     for note in gain_notes(config):
         print(f"note: {note}", file=sys.stderr)
     health = HealthMonitor.for_robot(config, _warn_line, clock.now)

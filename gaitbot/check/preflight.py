@@ -19,6 +19,14 @@ from gaitbot.gait.trajectory import Trajectory
 from gaitbot.robot.config import RobotConfig
 
 
+class LimitBroken(UserError):
+    """A walk breaks a limit of the robot (or would tip it over): refused before anything moves, in one line.
+    The check failed, as ``gaitbot check`` fails on the same file: exit 1 (docs/command-line.md), not 2 (the
+    input is readable). ``gaitbot generate`` raises it too, after writing the walk ``gaitbot walk`` would refuse."""
+
+    exit_status = 1
+
+
 class TrajectoryMismatch(UserError, ValueError):
     """A trajectory moves a joint the robot does not have, or one it holds: one line, exit 2."""
 

@@ -10,12 +10,9 @@ Per joint it checks:
 * the servo's tick range after calibration (ticks rounded as the streamer rounds them);
   for servos whose encoder wraps (0 and max_tick are neighbours) a tick outside the range, or two
   consecutive ticks whose shortest way round crosses the seam, is a ``wrap_seam`` violation;
-* velocity against max_velocity_dps: forward differences between consecutive samples,
-  attributed to the later sample's time, over at most ``MAX_FRAME_PERIOD_S`` (0.1 s): a position
-  servo makes a goal change that fast whatever the time stamps say, so a slow rate cannot hide a jump;
-* acceleration against max_acceleration_dps2: second differences at the file's own (possibly
-  non-uniform) sample times, ``a_k = 2 (v_{k+1/2} - v_{k-1/2}) / (t_{k+1} - t_{k-1})``,
-  attributed to the middle sample.
+* velocity against max_velocity_dps and acceleration against max_acceleration_dps2, as the servos
+  see them: gaitbot.robot.joint_motion (the one definition, shared with the recordings' check and the
+  planners) on the goal ticks at the frame times.
 
 Consecutive samples beyond the same limit form one Violation (an episode) that reports the worst
 value and when it happened, so an hour-long bad file gives a readable list, not a million lines.
@@ -30,13 +27,8 @@ import numpy as np
 
 from gaitbot.robot.calibration import angle_rad_to_ticks, full_angles_rad, joint_parameters
 from gaitbot.robot.config import JointConfig, RobotConfig
+from gaitbot.robot.joint_motion import ACCELERATION_METHOD, VELOCITY_METHOD, as_sent_deg, joint_motion
 
-VELOCITY_METHOD = "forward differences between consecutive samples, attributed to the later sample time"
-ACCELERATION_METHOD = ("second differences with non-uniform spacing, 2*(v[k+1/2]-v[k-1/2])/(t[k+1]-t[k-1]), "
-                       "attributed to the middle sample time")
-#: The longest period a frame change is measured over (1 / 10 Hz, the lowest rate a walk streams at):
-#: a goal 45 deg away is a 45 deg jump whether it comes 0.1 s or 1000 s after the one before.
-MAX_FRAME_PERIOD_S = 0.1
 KIND_ORDER = ("position", "tick_range", "wrap_seam", "velocity", "acceleration", "balance", "feet")
 _UNITS = {"position": "deg", "tick_range": "ticks", "wrap_seam": "ticks", "velocity": "deg/s",
           "acceleration": "deg/s^2", "balance": "mm", "feet": "mm"}
@@ -268,12 +260,9 @@ def check_trajectory(config: RobotConfig, t_s, angles_deg, margin_deg: float = 0
     v_lim = np.array([j.max_velocity_dps for j in joints])
     a_lim = np.array([j.max_acceleration_dps2 for j in joints])
 
-    # A position servo makes each goal change within one period of the slowest rate a walk may stream at,
-    # however far apart the frames are stamped: velocity and acceleration are measured over at most that.
-    dt = np.minimum(dt, MAX_FRAME_PERIOD_S)
-    velocity = np.diff(angles, axis=0) / dt[:, None]  # (N-1, J) at t[1:]
+    # The one definition (gaitbot.robot.joint_motion): the goal ticks as sent, at the frame times.
+    velocity, acceleration = joint_motion(t, as_sent_deg(config, angles))  # at t[1:] and t[1:-1]
     t_vel = t[1:]
-    acceleration = 2.0 * np.diff(velocity, axis=0) / (dt[1:] + dt[:-1])[:, None]  # (N-2, J) at t[1:-1]
     t_acc = t[1:-1]
 
     zero, direction, tpr = joint_parameters(config)

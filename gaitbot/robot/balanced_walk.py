@@ -19,7 +19,10 @@ from gaitbot.gait.balance.walker import (BalancedGaitSettings, BalancedWalk, Bal
                                          walk_of, plan_balanced_walk)
 from gaitbot.gait.joints import LEG_JOINTS
 from gaitbot.robot.config import RobotConfig
+from gaitbot.robot.calibration import full_angles_rad
 from gaitbot.robot.gains import gain_for_error
+from gaitbot.robot.joint_motion import as_sent_deg, joint_motion, limit_shares
+from gaitbot.robot.motion_margin import PLANNED_SHARE
 
 
 def balanced_gait_settings(config: RobotConfig, *, cycle_s: float | None = None, rate_hz: float | None = None,
@@ -74,6 +77,20 @@ def velocity_limit_dps(config: RobotConfig) -> float:
     return min(j.max_velocity_dps for j in config.walking_joints)
 
 
+def motion_measure(config: RobotConfig):
+    """``measure(q_rad, rate_hz) -> (share, peak deg/s)`` of (N, 12) leg angles (LEG_JOINTS order) for the
+    speed fit: the largest share of any joint's velocity or acceleration limit, and the fastest joint's
+    speed, as its servo is sent them (gaitbot.robot.joint_motion, the definition ``gaitbot check`` uses)."""
+    def measure(q_rad, rate_hz: float):
+        t = np.arange(len(q_rad)) / rate_hz
+        angles = np.degrees(full_angles_rad(config, q_rad, LEG_JOINTS))
+        v, a = limit_shares(config, t, angles)
+        velocity, _ = joint_motion(t, as_sent_deg(config, angles))
+        peak_dps = float(np.abs(velocity).max()) if len(velocity) else 0.0
+        return float(max(v.max(), a.max())), peak_dps
+    return measure
+
+
 def check_balanced_robot(config: RobotConfig) -> None:
     """The balanced walker moves all twelve leg joints; a robot must have them (held ones at 0)."""
     for name in LEG_JOINTS:
@@ -87,10 +104,24 @@ def check_balanced_robot(config: RobotConfig) -> None:
 
 
 def balanced_walker(config: RobotConfig, gait: BalancedGaitSettings | None = None, balance=None) -> BalancedWalker:
-    """An online balanced walker for the robot (steps appended while walking)."""
+    """An online balanced walker for the robot (steps appended while walking). Without ``balance``, the
+    robot's ``[balance]`` fitted to its servos' limits with the planning margin for a steady walk at the
+    gait's longest step (``fitted_settings``), as a planned walk is."""
     check_balanced_robot(config)
-    return BalancedWalker(config.body, gait or balanced_gait_settings(config), balance or config.balance,
+    gait = gait or balanced_gait_settings(config)
+    if balance is None:
+        fit = fitted_settings(config, gait)
+        gait, balance = fit.gait, fit.balance
+    return BalancedWalker(config.body, gait, balance,
                           limits_rad=leg_limits_rad(config), kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
+
+
+def fitted_settings(config: RobotConfig, gait: BalancedGaitSettings) -> SpeedFit:
+    """The speed fit (its ``balance`` and ``gait``: the clearance may be lowered) of a steady walk at
+    ``gait.max_step_m`` to the servos' limits (gaitbot.gait.balance.speed_fit, with PLANNED_SHARE)."""
+    options = dict(limits_rad=leg_limits_rad(config), kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
+    return fit_to_servo_speed(config.body, gait, config.balance, velocity_limit_dps(config),
+                              measure=motion_measure(config), share=PLANNED_SHARE, **options)
 
 
 @dataclass(frozen=True)
@@ -114,13 +145,21 @@ class BalancedPlan:
 def plan_balanced(config: RobotConfig, step_lengths, gait: BalancedGaitSettings | None = None,
                   speed_fit: bool = True) -> BalancedPlan:
     """The whole walk, offline; with ``speed_fit`` the robot's ``[balance]`` is relaxed first where the
-    cycle or step would ask a joint for more than its max_velocity_dps (gaitbot.gait.balance.speed_fit)."""
+    cycle or step would ask a joint for more than PLANNED_SHARE of its max_velocity_dps or max_acceleration_dps2
+    (gaitbot.gait.balance.speed_fit, gaitbot.robot.motion_margin)."""
     check_balanced_robot(config)
     gait = gait or balanced_gait_settings(config)
     options = dict(limits_rad=leg_limits_rad(config), kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
     if speed_fit:
-        fit = fit_to_servo_speed(config.body, gait, config.balance, velocity_limit_dps(config), step_lengths,
-                                 **options)
+        # A walk of steady steps is fitted from the settings of the steady walk at the gait's longest step
+        # on, so that steady walks of any length under one longest step walk with the same settings (a
+        # family: eigen-gaits are fitted to them); other walks (varied steps) for their own steps.
+        fit_options = dict(measure=motion_measure(config), share=PLANNED_SHARE, **options)
+        limit = velocity_limit_dps(config)
+        first = 0
+        if len(set(step_lengths)) == 1:  # a steady walk: one family with the steady walk of its longest step
+            first = fit_to_servo_speed(config.body, gait, config.balance, limit, **fit_options).relaxed
+        fit = fit_to_servo_speed(config.body, gait, config.balance, limit, step_lengths, first=first, **fit_options)
         return BalancedPlan(fit.walk, fit, fit.walker)
     walker = plan_balanced_walk(config.body, step_lengths, gait, config.balance, **options)
     walk = walk_of(walker)

@@ -21,6 +21,11 @@ from gaitbot.robot.config import load_robot_config, resolve_config
 
 RATE_HZ = 60.0
 DT = 1.0 / RATE_HZ
+#: Velocities and accelerations are measured on the goal ticks as sent (gaitbot.robot.joint_motion): an XL430's
+#: tick is 360/4096 deg, so rounding moves a velocity by at most one tick per frame and an acceleration by two.
+TICK_DEG = 360.0 / 4096
+V_TICK = TICK_DEG / DT
+A_TICK = 2 * TICK_DEG / DT ** 2
 POSE_DEG = [10.0, 30.0, -10.0, 10.0, 30.0, -10.0]  # hip, knee, ankle (left, right): far from every limit
 COL = {"hip_pitch_left": 0, "knee_pitch_left": 1, "ankle_pitch_left": 2,
        "hip_pitch_right": 3, "knee_pitch_right": 4, "ankle_pitch_right": 5}
@@ -86,8 +91,8 @@ def test_smooth_gait_like_trajectory_passes(xl430):
     assert [j.verdict for j in report.joints] == ["ok"] * 6
     knee = report.joints[1]
     assert knee.joint == "knee_pitch_left"
-    assert knee.worst_velocity_dps == pytest.approx(25 * w, rel=2e-3)
-    assert knee.worst_acceleration_dps2 == pytest.approx(25 * w * w, rel=2e-3)
+    assert knee.worst_velocity_dps == pytest.approx(25 * w, abs=V_TICK)
+    assert knee.worst_acceleration_dps2 == pytest.approx(25 * w * w, abs=A_TICK)
     assert knee.used_min_deg == pytest.approx(5.0, abs=0.01) and knee.used_max_deg == pytest.approx(55.0, abs=0.01)
     # closest approach: 55 deg is 55 below max 110; 5 deg is 10 above min -5 -> 10
     assert knee.closest_to_limit_deg == pytest.approx(10.0, abs=0.01)
@@ -144,7 +149,7 @@ def test_velocity_over_limit_found_at_its_joint_and_time(xl430):
     (v,) = report.violations
     assert (v.kind, v.joint, v.limit_name, v.limit) == ("velocity", "knee_pitch_right", "max_velocity_dps", 300.0)
     assert abs(v.t_s - (t0 + 8 * DT)) <= DT
-    assert v.value == pytest.approx(3000 * math.sin(math.pi / 30), rel=1e-6)
+    assert v.value == pytest.approx(3000 * math.sin(math.pi / 30), abs=V_TICK)
     assert v.n_samples == 3
     assert v.t_start_s == pytest.approx(t0 + 7 * DT) and v.t_end_s == pytest.approx(t0 + 9 * DT)
     assert report.joints[COL["knee_pitch_right"]].worst_acceleration_dps2 < 6000
@@ -166,9 +171,9 @@ def test_acceleration_over_limit_found_at_its_joint_and_time(xl430):
     assert (v.kind, v.joint, v.limit_name, v.limit) == ("acceleration", "ankle_pitch_left",
                                                         "max_acceleration_dps2", 6000.0)
     assert v.t_s == pytest.approx(t0 + 3 * DT) and v.n_samples == 1
-    assert v.value == pytest.approx(7200.0, rel=1e-6)
+    assert v.value == pytest.approx(7200.0, abs=A_TICK)
     summary = report.joints[COL["ankle_pitch_left"]]
-    assert summary.worst_velocity_dps == pytest.approx(120.0, rel=1e-6)
+    assert summary.worst_velocity_dps == pytest.approx(120.0, abs=V_TICK)
 
 
 def test_differences_use_the_files_own_non_uniform_times(xl430):
@@ -179,8 +184,8 @@ def test_differences_use_the_files_own_non_uniform_times(xl430):
     angles = np.zeros((4, 6))
     angles[:, 1] = [0, 1, 5, 5]
     knee = check_trajectory(xl430, t, angles).joints[1]
-    assert knee.worst_velocity_dps == pytest.approx(40.0) and knee.worst_velocity_t_s == pytest.approx(0.15)
-    assert knee.worst_acceleration_dps2 == pytest.approx(1600 / 3) and knee.worst_acceleration_t_s == pytest.approx(0.15)
+    assert knee.worst_velocity_dps == pytest.approx(40.0, abs=TICK_DEG / 0.05) and knee.worst_velocity_t_s == pytest.approx(0.15)
+    assert knee.worst_acceleration_dps2 == pytest.approx(1600 / 3, abs=2 * TICK_DEG / 0.05 / 0.075) and knee.worst_acceleration_t_s == pytest.approx(0.15)
 
 
 def test_a_slow_rate_cannot_hide_a_jump(xl430):
@@ -313,7 +318,7 @@ def test_report_text_and_json(xl430):
     angles[:, 1] += steps
     report = check_trajectory(xl430, t, angles)
     velocity = of(report, "knee_pitch_left", "velocity")
-    assert len(velocity) == 20 and all(v.value == pytest.approx(600.0) for v in velocity)
+    assert len(velocity) == 20 and all(v.value == pytest.approx(600.0, abs=V_TICK) for v in velocity)
     text = report.format_text(max_per_kind=5)
     assert "knee_pitch_left" in text and "velocity (20):" in text and "... and 15 more" in text
     assert "forward differences" in text and "second differences" in text

@@ -132,7 +132,8 @@ def test_the_planned_zmp_stays_inside_the_feet(walk):
 
 
 def test_online_equals_offline(walk):
-    walker = balanced_walker(OP3)
+    fit = plan_balanced(OP3, STEPS).fit  # the settings the offline walk was fitted to (the servos' limits)
+    walker = balanced_walker(OP3, fit.gait, fit.balance)
     for length in STEPS:
         walker.append_step(length)
     frames = []

@@ -8,8 +8,10 @@ and step (on the OP3 a 15% double support, the progression done at 80% of the sw
 1 / ((1 - double support) x progression_end) and its lift with the clearance, so the candidates are, in
 order: the robot's values; the same 10 deg deeper in the crouch (the bent knee lifts and swings the foot
 with less speed); double support 10% / progression 0.9; 5% / 1.0 / clearance 3 mm; the last 10 deg deeper;
-the first whose steady walk at the longest step keeps every joint under its limit is used (the last
-if none does: the limit check then says which joint, and when). The walk itself is planned for each
+the first whose walk keeps every joint at or under ``share`` of its limits (the robot's planners keep
+PLANNED_SHARE, gaitbot.robot.motion_margin, measured by gaitbot.robot.joint_motion: velocity and
+acceleration of the goal ticks as sent) is used (if none does, the one that asks the least share of a
+limit: the limit check then says whether it is still within the limits, which joint, and when). The walk itself is planned for each
 candidate until one fits (an offline walk of 2 m takes ~0.1 s).
 """
 
@@ -32,7 +34,9 @@ PROBE_STEPS = 4
 @dataclass(frozen=True, eq=False)
 class SpeedFit:
     """The settings walked with, the walk's peak joint speed (deg/s, planned angles or goals) against the
-    limit, which candidate was taken (0: the robot's own values), and the walk (with its walker)."""
+    limit, which candidate was taken (0: the robot's own values), and the walk (with its walker).
+    ``peak_share``: the largest share of a joint's velocity or acceleration limit the walk reaches (planned
+    angles or goals), against ``target_share``, the share the fit keeps to."""
 
     balance: BalanceSettings
     gait: BalancedGaitSettings
@@ -41,10 +45,12 @@ class SpeedFit:
     relaxed: int
     walk: BalancedWalk | None = None
     walker: BalancedWalker | None = None
+    peak_share: float = float("nan")
+    target_share: float = 1.0
 
     @property
     def fits(self) -> bool:
-        return self.peak_dps <= self.limit_dps
+        return self.peak_share <= self.target_share
 
 
 def peak_joint_speed_dps(q_rad, rate_hz: float) -> float:
@@ -64,23 +70,34 @@ def candidates(gait: BalancedGaitSettings, balance: BalanceSettings):
 
 
 def fit_to_servo_speed(body: BodyModel, gait: BalancedGaitSettings, balance: BalanceSettings, limit_dps: float,
-                       steps=None, **options) -> SpeedFit:
+                       steps=None, *, measure=None, share: float = 1.0, first: int = 0, **options) -> SpeedFit:
     """The first candidate whose walk (``steps``; default a steady walk at ``gait.max_step_m``) keeps every
-    leg joint's planned angle and goal under ``limit_dps``; ``options`` go to the walker (limits, stiffness).
-    A candidate the joint limits refuse is skipped; if every one is refused, the first refusal is raised."""
+    leg joint's planned angle and goal at or under ``share`` of its limits; ``options`` go to the walker
+    (limits, stiffness). ``measure(q_rad, rate_hz) -> (share of the limits, peak deg/s)`` of (N, 12) leg
+    angles measures a walk (default: the peak speed over ``limit_dps``, gaitbot.robot.balanced_walk gives the
+    robot's, gaitbot.robot.joint_motion). Candidates are tried from index ``first`` on (a walk of one family
+    starts where its steady walk's fit ended). A candidate the joint limits refuse is skipped; if every one
+    is refused, the first refusal is raised."""
+    if measure is None:
+        def measure(q_rad, rate_hz):
+            peak_dps = peak_joint_speed_dps(q_rad, rate_hz)
+            return peak_dps / limit_dps, peak_dps
+
     steps = [gait.max_step_m] * PROBE_STEPS if steps is None else list(steps)
-    fit, refused = None, None
-    for i, (b, g) in enumerate(candidates(gait, balance)):
+    fit, best, refused = None, None, None
+    for i, (b, g) in list(enumerate(candidates(gait, balance)))[first:]:
         try:
             walker = plan_balanced_walk(body, steps, g, b, **options)
             walk = walk_of(walker)
         except BalancedWalkError as exc:
             refused = refused or exc
             continue
-        peak = max(peak_joint_speed_dps(walk.q_rad, g.rate_hz), peak_joint_speed_dps(walk.goals_rad, g.rate_hz))
-        fit = SpeedFit(b, g, peak, limit_dps, i, walk, walker)
+        (share_q, peak_q), (share_goals, peak_goals) = measure(walk.q_rad, g.rate_hz), measure(walk.goals_rad, g.rate_hz)
+        fit = SpeedFit(b, g, max(peak_q, peak_goals), limit_dps, i, walk, walker, max(share_q, share_goals), share)
         if fit.fits:
-            break
-    if fit is None:
+            return fit
+        if best is None or fit.peak_share < best.peak_share:
+            best = fit
+    if best is None:
         raise refused
-    return fit
+    return best

@@ -18,7 +18,8 @@ from ..geometry import LegGeometry, leg_ik
 from ..walk_segments import MIN_KNEE_RAD, crouch_leg_scale
 
 FREE_KNEE_RAD = np.radians(150.0)  # the knee's bend when no joint ranges are given
-MOTION_SHARE = 0.8  # plans keep joint speeds and accelerations below this share of the limits (samples are sparse)
+MOTION_SHARE = 0.8  # the search aims below this share of the limits (its samples are sparse); the walk is then
+# held to the robot's planning margin as a whole (gaitbot.robot.planar_fit stretches its cycle if needed)
 
 
 @dataclass(frozen=True)
