@@ -36,9 +36,9 @@ class StubReader:
 
 def strong_op3(**imu):
     cfg = config("op3")
-    return dataclasses.replace(cfg, imu=dataclasses.replace(cfg.imu, ankle_pitch_s=0.5, hip_pitch_s=0.5, ankle_roll_s=0.5,
-                                                            hip_roll_s=0.5, attitude_gain=1.0, max_correction_deg=30.0,
-                                                            fall_tilt_deg=89.0, fall_tilt_rate_dps=2000.0, **imu))
+    settings = dict(ankle_pitch_s=0.5, hip_pitch_s=0.5, ankle_roll_s=0.5, hip_roll_s=0.5, attitude_roll_gain=1.0,
+                    attitude_pitch_gain=1.0, max_correction_deg=30.0, fall_tilt_deg=89.0, fall_tilt_rate_dps=2000.0)
+    return dataclasses.replace(cfg, imu=dataclasses.replace(cfg.imu, **{**settings, **imu}))
 
 
 def reading(gyro_dps, acc_g=(0.0, 0.0, 1.0)) -> ImuReading:
@@ -82,6 +82,30 @@ def test_gyro_damping_turns_the_torso_against_its_rate_on_either_stance_leg(gyro
         after = stance_torso_pitch_roll(cfg, corrected, side)[index]
         # gyro y > 0: pitching forward (pitch up); gyro x > 0: rolling right, which is roll (about x) up
         assert sign * (after - before) > 0.5
+
+
+@pytest.mark.parametrize("axis, tilt_deg", [(1, 6.0), (1, -6.0), (0, 6.0), (0, -6.0)])
+def test_the_attitude_term_turns_a_still_tilted_torso_back_and_only_on_its_own_axis(axis, tilt_deg):
+    """A torso held still at a lean (gravity says so, no rate): "full" with a gain on that axis alone moves the
+    goals so that, on either stance foot, the torso turns back towards upright about that axis, not the other."""
+    gains = {"attitude_roll_gain": 1.0 if axis == 1 else 0.0, "attitude_pitch_gain": 1.0 if axis == 0 else 0.0}
+    cfg = strong_op3(**gains)
+    names = [j.name for j in cfg.joints]
+    crouch = {n: math.radians({"hip_pitch": 30, "knee_pitch": 60, "ankle_pitch": 30}.get(n.rsplit("_", 1)[0], 0))
+              for n in names}
+    row = angles_to_ticks(cfg, np.array([crouch[n] for n in names]))
+    stub = StubReader()
+    fb = Feedback(cfg, "full", stub, PERIOD_S, lambda: 0.0)
+    lean = math.radians(tilt_deg)
+    # pitch (axis 0) forward: gravity along -x in the body; roll (axis 1) right: gravity along +y
+    stub.next = reading([0.0, 0.0, 0.0], [-math.sin(lean), 0.0, math.cos(lean)] if axis == 0
+                        else [0.0, math.sin(lean), math.cos(lean)])
+    fb.sense(0.0)
+    corrected = dict(zip(names, ticks_to_angles(cfg, fb.correct(0, row))))
+    for side in ("left", "right"):
+        before, after = stance_torso_pitch_roll(cfg, crouch, side), stance_torso_pitch_roll(cfg, corrected, side)
+        assert -np.sign(tilt_deg) * (after[axis] - before[axis]) > 3.0  # turned back, by about the lean
+        assert after[1 - axis] == pytest.approx(before[1 - axis], abs=0.2)  # the other axis left alone
 
 
 @settings(max_examples=15, deadline=None)
