@@ -109,10 +109,12 @@ class Feedback:
             if self.mode == "full":
                 wanted = wanted + self.attitude @ np.radians([self.estimate.roll_deg, self.estimate.pitch_deg])
             wanted = np.clip(wanted, -self.max_correction_rad, self.max_correction_rad)
-        goal = self.within_limits(row + wanted * self.ticks_per_rad)
+        # whole ticks, as sent: the next frame's window is taken from these (a window from the unrounded goals
+        # let the sent ticks' second difference exceed the acceleration limit by a tick)
+        goal = np.rint(self.within_limits(row + wanted * self.ticks_per_rad))
         self.correction_rad = (goal - row) / self.ticks_per_rad
         self.previous, self.last = self.last, goal
-        return np.rint(goal).astype(np.int64)
+        return goal.astype(np.int64)
 
     def within_limits(self, goal: np.ndarray) -> np.ndarray:
         """``goal`` clipped to what the limits allow after the last two goals sent (module docstring)."""
