@@ -64,19 +64,25 @@ def stance_torso_pitch_roll(cfg, angles_by_name: dict, side: str) -> tuple[float
     return math.degrees(math.atan2(-torso[2, 0], torso[2, 2])), math.degrees(math.atan2(torso[2, 1], torso[2, 2]))
 
 
-@pytest.mark.parametrize("gyro, index, sign", [([0.0, 50.0, 0.0], 0, -1), ([0.0, -50.0, 0.0], 0, 1),
-                                               ([50.0, 0.0, 0.0], 1, -1), ([-50.0, 0.0, 0.0], 1, 1)])
-def test_gyro_damping_turns_the_torso_against_its_rate_on_either_stance_leg(gyro, index, sign):
-    cfg = strong_op3()
+def corrected_crouch(cfg, mode: str, imu: ImuReading):
+    """A walking crouch (hip 30, knee 60, ankle 30 deg), one ``imu`` reading, and the goals ``mode`` corrects
+    it to: (the crouch's angles, the corrected angles), by joint name (rad)."""
     names = [j.name for j in cfg.joints]
     crouch = {n: math.radians({"hip_pitch": 30, "knee_pitch": 60, "ankle_pitch": 30}.get(n.rsplit("_", 1)[0], 0))
               for n in names}
     row = angles_to_ticks(cfg, np.array([crouch[n] for n in names]))
     stub = StubReader()
-    fb = Feedback(cfg, "gyro", stub, PERIOD_S, lambda: 0.0)
-    stub.next = reading(gyro)
+    fb = Feedback(cfg, mode, stub, PERIOD_S, lambda: 0.0)
+    stub.next = imu
     fb.sense(0.0)
-    corrected = dict(zip(names, ticks_to_angles(cfg, fb.correct(0, row))))
+    return crouch, dict(zip(names, ticks_to_angles(cfg, fb.correct(0, row))))
+
+
+@pytest.mark.parametrize("gyro, index, sign", [([0.0, 50.0, 0.0], 0, -1), ([0.0, -50.0, 0.0], 0, 1),
+                                               ([50.0, 0.0, 0.0], 1, -1), ([-50.0, 0.0, 0.0], 1, 1)])
+def test_gyro_damping_turns_the_torso_against_its_rate_on_either_stance_leg(gyro, index, sign):
+    cfg = strong_op3()
+    crouch, corrected = corrected_crouch(cfg, "gyro", reading(gyro))
     for side in ("left", "right"):
         before = stance_torso_pitch_roll(cfg, crouch, side)[index]
         after = stance_torso_pitch_roll(cfg, corrected, side)[index]
@@ -90,18 +96,10 @@ def test_the_attitude_term_turns_a_still_tilted_torso_back_and_only_on_its_own_a
     goals so that, on either stance foot, the torso turns back towards upright about that axis, not the other."""
     gains = {"attitude_roll_gain": 1.0 if axis == 1 else 0.0, "attitude_pitch_gain": 1.0 if axis == 0 else 0.0}
     cfg = strong_op3(**gains)
-    names = [j.name for j in cfg.joints]
-    crouch = {n: math.radians({"hip_pitch": 30, "knee_pitch": 60, "ankle_pitch": 30}.get(n.rsplit("_", 1)[0], 0))
-              for n in names}
-    row = angles_to_ticks(cfg, np.array([crouch[n] for n in names]))
-    stub = StubReader()
-    fb = Feedback(cfg, "full", stub, PERIOD_S, lambda: 0.0)
     lean = math.radians(tilt_deg)
     # pitch (axis 0) forward: gravity along -x in the body; roll (axis 1) right: gravity along +y
-    stub.next = reading([0.0, 0.0, 0.0], [-math.sin(lean), 0.0, math.cos(lean)] if axis == 0
-                        else [0.0, math.sin(lean), math.cos(lean)])
-    fb.sense(0.0)
-    corrected = dict(zip(names, ticks_to_angles(cfg, fb.correct(0, row))))
+    crouch, corrected = corrected_crouch(cfg, "full", reading([0.0, 0.0, 0.0], [-math.sin(lean), 0.0, math.cos(lean)]
+                                                              if axis == 0 else [0.0, math.sin(lean), math.cos(lean)]))
     for side in ("left", "right"):
         before, after = stance_torso_pitch_roll(cfg, crouch, side), stance_torso_pitch_roll(cfg, corrected, side)
         assert -np.sign(tilt_deg) * (after[axis] - before[axis]) > 3.0  # turned back, by about the lean
