@@ -4,7 +4,11 @@
 
 The IMU read itself goes over the bus (its wire time at 2 Mbaud is a fact of the packets: gaitbot.servos.opencr);
 here the reader's bus is a stub that returns a recorded-like block at once, so the figures are the host's
-work per frame: decoding the block, the complementary filter, the gyro damping and the limit window.
+work per frame: decoding the block, the complementary filter, the gyro damping, the attitude term and the
+limit window. Two lines: the feedback alone (--frames frames of a sway), and the frame a walk with feedback
+really does, the online balanced walker's ``next_frame`` (30 steps queued, as tools/bench_balance.py) with the
+feedback on its goals. Both in wall time and in CPU time of this thread (time.thread_time): on a shared machine
+the wall p99 is the host's scheduling, the CPU p99 is the code's.
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ import numpy as np
 
 from gaitbot.feel.feedback import Feedback
 from gaitbot.feel.imu_reader import ImuReader
+from gaitbot.robot.balanced_walk import balanced_walker
 from gaitbot.robot.calibration import angles_to_ticks
 from gaitbot.robot.config import load_robot_config, resolve_config
 from gaitbot.servos.opencr import IMU_READ_WIRE_S, encode_imu_block
@@ -32,29 +37,69 @@ class StubBus:
                                 [0.0, 0.0, 0.0])
 
 
+def percentiles(label: str, wall, cpu, what: str) -> str:
+    wall, cpu = np.array(wall) * 1e3, np.array(cpu) * 1e3
+    return (f"{label}: wall p50 {np.percentile(wall, 50):.3f} ms, p99 {np.percentile(wall, 99):.3f} ms, max "
+            f"{wall.max():.3f} ms; CPU p50 {np.percentile(cpu, 50):.3f} ms, p99 {np.percentile(cpu, 99):.3f} ms, "
+            f"max {cpu.max():.3f} ms over {len(wall)} {what}")
+
+
+def feedback_of(config, period: float, clock: list[float]) -> Feedback:
+    reader = ImuReader(StubBus(), config.imu, lambda: clock[0], period)
+    return Feedback(config, "full", reader, period, lambda: clock[0])
+
+
+def feedback_alone(config, frames: int) -> str:
+    period, clock = 1 / config.gait.rate_hz, [0.0]
+    feedback = feedback_of(config, period, clock)
+    t = np.arange(frames) * period
+    plan = np.radians(10.0) * np.sin(2 * np.pi * t / config.gait.cycle_s)[:, None] * np.ones(len(config.joints))
+    rows = angles_to_ticks(config, plan)
+    wall, cpu = np.empty(frames), np.empty(frames)
+    for k in range(frames):
+        clock[0] = k * period
+        w, c = time.perf_counter(), time.thread_time()
+        feedback.sense(clock[0])
+        feedback.correct(k, rows[k])
+        wall[k], cpu[k] = time.perf_counter() - w, time.thread_time() - c
+    return percentiles("IMU read + estimate + feedback", wall, cpu, "frames")
+
+
+def walker_with_feedback(config) -> str:
+    """The online walker's frame, its goals in ticks, and the feedback on them (a frame of a live walk)."""
+    period, clock = 1 / config.gait.rate_hz, [0.0]
+    feedback = feedback_of(config, period, clock)
+    walker = balanced_walker(config)
+    for _ in range(30):
+        walker.append_step(0.05)
+    names = [j.name for j in config.joints]
+    from gaitbot.gait.joints import LEG_JOINTS
+    column = [LEG_JOINTS.index(n) for n in names]
+    wall, cpu, k = [], [], 0
+    while True:
+        w, c = time.perf_counter(), time.thread_time()
+        frame = walker.next_frame()
+        if frame is None:
+            break
+        row = angles_to_ticks(config, np.asarray(frame[2])[column][None])[0]
+        feedback.sense(clock[0])
+        feedback.correct(k, row)
+        wall.append(time.perf_counter() - w)
+        cpu.append(time.thread_time() - c)
+        k += 1
+        clock[0] = k * period
+    return percentiles("walker next_frame + ticks + IMU read + estimate + feedback", wall, cpu, "frames")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robot", default="op3")
     parser.add_argument("--frames", type=int, default=5000)
     args = parser.parse_args()
     config = load_robot_config(resolve_config(args.robot))
-    period = 1 / config.gait.rate_hz
-    clock = [0.0]
-    reader = ImuReader(StubBus(), config.imu, lambda: clock[0], period)
-    feedback = Feedback(config, "full", reader, period, lambda: clock[0])
-    t = np.arange(args.frames) * period
-    plan = np.radians(10.0) * np.sin(2 * np.pi * t / config.gait.cycle_s)[:, None] * np.ones(len(config.joints))
-    rows = angles_to_ticks(config, plan)
-    costs = np.empty(args.frames)
-    for k in range(args.frames):
-        clock[0] = k * period
-        start = time.perf_counter()
-        feedback.sense(clock[0])
-        feedback.correct(k, rows[k])
-        costs[k] = time.perf_counter() - start
-    print(f"{config.name}: IMU read + estimate + feedback per frame over {args.frames} frames: median "
-          f"{np.median(costs) * 1e3:.3f} ms, p99 {np.percentile(costs, 99) * 1e3:.3f} ms, max {costs.max() * 1e3:.3f} ms "
-          f"(host work; the read's wire time at 2 Mbaud is {IMU_READ_WIRE_S * 1e3:.3f} ms)")
+    print(f"{config.name}: {feedback_alone(config, args.frames)}")
+    print(f"{config.name}: {walker_with_feedback(config)}")
+    print(f"{config.name}: the IMU READ's wire time at 2 Mbaud: {IMU_READ_WIRE_S * 1e3:.3f} ms (43 bytes)")
 
 
 if __name__ == "__main__":

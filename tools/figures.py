@@ -36,7 +36,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
-REGION = re.compile(r"<!-- figure ([\w-]+): (.+?)(; simulated)? -->\n(.*?)<!-- /figure -->", re.S)
+REGION = re.compile(r"<!-- figure ([\w-]+): (.+?)(; simulated)?(; long)? -->\n(.*?)<!-- /figure -->", re.S)
+LONG_FIGURES_ENV = "GAITBOT_LONG_FIGURES"
+"""Set to 1, the test suite also reruns the figures marked ``; long`` (minutes each; tools/figures.py --check
+always does)."""
 PRINTED = re.compile(r"<!-- figure ([\w-]+) -->\n(.*?)<!-- /figure -->", re.S)
 NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
 
@@ -81,6 +84,9 @@ class Region:
     command: str
     text: str
     simulated: bool = False
+    long: bool = False
+    """Marked ``; long``: its command runs for minutes (a hundred pushes, a ten-minute drive), too long for every
+    test run; ``python tools/figures.py --check`` reruns it, the suite only with LONG_FIGURES_ENV=1."""
 
     @property
     def units(self) -> int:
@@ -97,7 +103,7 @@ def regions(pages=PAGES) -> list[Region]:
     found = []
     for page in pages:
         text = page.read_text()
-        found += [Region(page, m.group(1), m.group(2).strip(), m.group(4), bool(m.group(3)))
+        found += [Region(page, m.group(1), m.group(2).strip(), m.group(5), bool(m.group(3)), bool(m.group(4)))
                   for m in REGION.finditer(text) if not _in_code(text, m.start())]
     return found
 
@@ -182,14 +188,15 @@ def rewrite(selected: list[Region]) -> int:
 
         def fill(match):
             nonlocal changed
-            name, command, simulated = match.group(1), match.group(2).strip(), match.group(3) or ""
+            name, command = match.group(1), match.group(2).strip()
+            marks = (match.group(3) or "") + (match.group(4) or "")
             if name not in names or _in_code(text, match.start()):
                 return match.group(0)
             if command not in cache:
                 cache[command] = run_figure_command(command)
             fresh = cache[command][name]
-            changed += fresh != match.group(4)
-            return f"<!-- figure {name}: {command}{simulated} -->\n{fresh}<!-- /figure -->"
+            changed += fresh != match.group(5)
+            return f"<!-- figure {name}: {command}{marks} -->\n{fresh}<!-- /figure -->"
 
         page.write_text(REGION.sub(fill, text))
     return changed

@@ -4,6 +4,7 @@
     python tools/push_survival.py --pushes 10        # fewer
     python tools/push_survival.py --robot bioloid --max-impulse 1.0
     python tools/push_survival.py --json             # one JSON object per push
+    python tools/push_survival.py --markdown         # docs/feedback.md's figure: survived per quarter of the range
 
 Each push is drawn from a seeded generator (--seed): an impulse uniform in 0..--max-impulse N s, a direction
 uniform in 0..360 deg (from forward, counter-clockwise), a phase uniform over the middle step (its share of
@@ -60,6 +61,27 @@ def one_push(robot: str, walk: str, impulse: float, direction: float, phase: flo
             "fall_direction": report["fall_direction"]}
 
 
+def markdown(args) -> str:
+    """The figure of docs/feedback.md: how many of the pushes in each quarter of 0..max impulse survived."""
+    rng = np.random.default_rng(args.seed)
+    draws = [(rng.uniform(0, args.max_impulse), rng.uniform(0, 360), rng.uniform(0, 1)) for _ in range(args.pushes)]
+    modes = args.modes.split(",")
+    edges = np.linspace(0, args.max_impulse, 5)
+    counts = np.zeros((4, 1 + len(modes)), dtype=int)
+    for n, (impulse, direction, phase) in enumerate(draws, start=1):
+        quarter = min(int(impulse / args.max_impulse * 4), 3)
+        counts[quarter, 0] += 1
+        for i, m in enumerate(modes):
+            counts[quarter, 1 + i] += one_push(args.robot, WALKS[args.robot], impulse, direction, phase, n, m)["survived"]
+    rows = ["| impulse N s | pushes | " + " | ".join(f"survived, feedback {m}" for m in modes) + " |",
+            "|---|---|" + "---|" * len(modes)]
+    for q in range(4):
+        rows.append(f"| {edges[q]:g} to {edges[q + 1]:g} | {counts[q, 0]} | "
+                    + " | ".join(str(c) for c in counts[q, 1:]) + " |")
+    rows.append(f"| all | {counts[:, 0].sum()} | " + " | ".join(str(c) for c in counts[:, 1:].sum(axis=0)) + " |")
+    return f"<!-- figure push-{args.robot} -->\n" + "\n".join(rows) + "\n<!-- /figure -->"
+
+
 def main_(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robot", default="op3", choices=sorted(WALKS))
@@ -68,7 +90,11 @@ def main_(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=23)
     parser.add_argument("--modes", default="none,full")
     parser.add_argument("--json", action="store_true")
+    parser.add_argument("--markdown", action="store_true", help="print the docs' figure (tools/figures.py)")
     args = parser.parse_args(argv)
+    if args.markdown:
+        print(markdown(args))
+        return 0
     rng = np.random.default_rng(args.seed)
     draws = [(rng.uniform(0, args.max_impulse), rng.uniform(0, 360), rng.uniform(0, 1)) for _ in range(args.pushes)]
     modes = args.modes.split(",")

@@ -36,6 +36,8 @@ from gaitbot.robot.calibration_file import load_robot_with_calibration
 from gaitbot.robot.config import load_robot_config, resolve_config
 from gaitbot.servos import baud_rates, baud_register_value
 from gaitbot.servos.models import servo_model
+from gaitbot.bus.imu_device import FAULTS as IMU_FAULTS, ImuDevice
+from gaitbot.servos.opencr import OPENCR_OP3_ID
 
 #: --protocol name -> (backend, protocol, default model)
 PROTOCOLS = {"dxl1": ("dynamixel", 1.0, "AX-12A"), "dxl2": ("dynamixel", 2.0, "XL430-W250"),
@@ -116,6 +118,38 @@ def hand_from_trajectory(robot, path: str, rate_hz: float | None = None) -> Hand
     return Hand({joint.id: ticks[:, column].tolist() for column, joint in enumerate(robot.joints)}, rate_hz)
 
 
+def imu_from_args(args: argparse.Namespace, config: EmulatorConfig) -> ImuDevice | None:
+    """The IMU device of ``--imu`` (its fall and fault), or None; ValueError naming the argument."""
+    if not args.imu:
+        if args.imu_fall_at_s is not None or args.imu_fault:
+            raise ValueError("--imu-fall-at-s and --imu-fault need --imu (an IMU on the line)")
+        return None
+    if config.protocol != 2.0:
+        raise ValueError("--imu: the OpenCR answers Dynamixel Protocol 2.0 only (this chain speaks "
+                         f"{config.backend} protocol {config.protocol:g})")
+    device_id = OPENCR_OP3_ID
+    if args.robot:
+        imu = load_robot_with_calibration(args.robot, args.calibration).imu
+        device_id = imu.device_id if imu.source == "opencr" else OPENCR_OP3_ID
+    if device_id in config.models:
+        raise ValueError(f"--imu: id {device_id} is a servo's on this chain")
+    fall = args.imu_fall_at_s
+    if fall is not None and not (math.isfinite(fall) and 0 <= fall <= 86_400):
+        raise ValueError(f"--imu-fall-at-s must be within 0..86400 s, got {fall}")
+    fault, at_s = None, 1.0
+    if args.imu_fault:
+        fault, _, when = args.imu_fault.partition("@")
+        if fault not in IMU_FAULTS:
+            raise ValueError(f"--imu-fault {args.imu_fault!r}: KIND is one of {', '.join(IMU_FAULTS)}")
+        try:
+            at_s = float(when) if when else 1.0
+        except ValueError:
+            raise ValueError(f"--imu-fault {args.imu_fault!r}: S must be a number of seconds") from None
+        if not (math.isfinite(at_s) and 0 <= at_s <= 86_400):
+            raise ValueError(f"--imu-fault {args.imu_fault!r}: S must be within 0..86400 s")
+    return ImuDevice(device_id=device_id, fall_at_s=fall, fault=fault, fault_at_s=at_s, seed=args.seed)
+
+
 def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
     check_numbers(args)
     config = _chain_from_args(args)
@@ -134,6 +168,7 @@ def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
     if absent:
         raise ValueError(f"--model-number: servo {', '.join(map(str, absent))} is not on the chain")
     config.model_numbers = {servo_id: int(number) for servo_id, number in numbers.items()}
+    config.imu = imu_from_args(args, config)
     if args.one_at_a_time and not config.fresh:
         raise ValueError("--one-at-a-time needs --factory-fresh (a chain of new servos, connected one by one)")
     config.one_at_a_time = args.one_at_a_time
@@ -293,6 +328,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the supply falls this many volts per second once faults start (--fault-after-*)")
     p.add_argument("--model-number", action="append", metavar="ID:NUMBER", help="this servo reports this model "
                    "number (ping and its Model Number register), e.g. 3:1060 for an XL430-W250 among XM430s")
+    p.add_argument("--imu", action="store_true", help="an OP3 OpenCR IMU on the line (at the robot's [imu] id, "
+                   "else 200; Protocol 2.0 only): its readings follow a gentle sway of the torso")
+    p.add_argument("--imu-fall-at-s", type=float, metavar="S", help="--imu: the torso falls forwards from S "
+                   "seconds after the first packet (120 deg/s until flat)")
+    p.add_argument("--imu-fault", metavar="KIND[@S]", help="--imu: from S seconds (default 1) the IMU is "
+                   f"{'|'.join(IMU_FAULTS)} (docs/feedback.md says what a walk does then)")
     return p
 
 

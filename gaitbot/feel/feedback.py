@@ -9,7 +9,8 @@ when it acts. Corrections (docs/feedback.md; gains per robot, ``[feedback]``):
   by +s k w_r (s = +1 left, -1 right). With the foot flat, the shank's lean is the ankle pitch and
   -s ankle roll, and the torso's pitch is hip - knee + ankle pitch (gaitbot.gait.kinematics6's
   conventions), so each term pushes against the tilting velocity: a damper in parallel with the servo.
-* attitude ("full"): the same joints by the estimated tilt (roll, pitch) times ``attitude_gain``.
+* attitude ("full"): the same joints by the estimated roll times ``attitude_roll_gain`` and pitch times
+  ``attitude_pitch_gain`` (deg/deg): the torso's lean held against as well as its rate.
 
 Every correction is clipped to ``max_correction_deg``, then each goal to the window its joint's limits
 allow from the last two goals sent: position limits, |step| <= max velocity x frame, |change of step| <=
@@ -76,8 +77,7 @@ class Feedback:
                     self.rate_gain_s[i, 0] = (1.0 if side == "left" else -1.0) * k
                 else:
                     self.rate_gain_s[i, 1] = k
-        self.attitude = self.rate_gain_s.copy()
-        self.attitude[self.attitude != 0] = np.sign(self.attitude[self.attitude != 0]) * s.attitude_gain
+        self.attitude = np.sign(self.rate_gain_s) * [s.attitude_roll_gain, s.attitude_pitch_gain]
         self.max_correction_rad = math.radians(s.max_correction_deg)
         self.last: np.ndarray | None = None
         self.previous: np.ndarray | None = None
@@ -109,10 +109,12 @@ class Feedback:
             if self.mode == "full":
                 wanted = wanted + self.attitude @ np.radians([self.estimate.roll_deg, self.estimate.pitch_deg])
             wanted = np.clip(wanted, -self.max_correction_rad, self.max_correction_rad)
-        goal = self.within_limits(row + wanted * self.ticks_per_rad)
+        # whole ticks, as sent: the next frame's window is taken from these (a window from the unrounded goals
+        # let the sent ticks' second difference exceed the acceleration limit by a tick)
+        goal = np.rint(self.within_limits(row + wanted * self.ticks_per_rad))
         self.correction_rad = (goal - row) / self.ticks_per_rad
         self.previous, self.last = self.last, goal
-        return np.rint(goal).astype(np.int64)
+        return goal.astype(np.int64)
 
     def within_limits(self, goal: np.ndarray) -> np.ndarray:
         """``goal`` clipped to what the limits allow after the last two goals sent (module docstring)."""

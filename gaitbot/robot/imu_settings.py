@@ -14,7 +14,8 @@
     hip_pitch_s = 0.0
     ankle_roll_s = 0.02
     hip_roll_s = 0.01
-    attitude_gain = 0.0        # "full": extra correction per degree of estimated tilt (deg/deg)
+    attitude_roll_gain = 0.0   # "full": extra correction per degree of estimated roll (deg/deg)
+    attitude_pitch_gain = 0.0  # "full": and per degree of estimated pitch (deg/deg)
     max_correction_deg = 8.0   # no correction beyond this on any joint
 
     [fall]
@@ -33,7 +34,8 @@ from typing import Any
 IMU_SOURCES = ("none", "opencr")
 FALL_RESPONSES = ("hold", "torque_off")
 IMU_KEYS = ("source", "id", "mount_rpy_deg", "gyro_noise_dps", "gyro_bias_dps", "acc_noise_g", "delay_frames")
-FEEDBACK_KEYS = ("ankle_pitch_s", "hip_pitch_s", "ankle_roll_s", "hip_roll_s", "attitude_gain", "max_correction_deg")
+FEEDBACK_KEYS = ("ankle_pitch_s", "hip_pitch_s", "ankle_roll_s", "hip_roll_s", "attitude_roll_gain", "attitude_pitch_gain",
+                 "max_correction_deg")
 FALL_KEYS = ("tilt_deg", "tilt_rate_dps", "response")
 MAX_DELAY_FRAMES = 30
 MAX_GAIN_S = 1.0
@@ -55,7 +57,8 @@ class ImuSettings:
     hip_pitch_s: float = 0.0
     ankle_roll_s: float = 0.0
     hip_roll_s: float = 0.0
-    attitude_gain: float = 0.0
+    attitude_roll_gain: float = 0.0
+    attitude_pitch_gain: float = 0.0
     max_correction_deg: float = 8.0
     fall_tilt_deg: float = 40.0
     fall_tilt_rate_dps: float = 250.0
@@ -96,8 +99,8 @@ def read_imu(fields: Any, data: dict, bus: Any) -> ImuSettings:
         raise fields.fail("imu.delay_frames", f"{delay} is outside the allowed 0..{MAX_DELAY_FRAMES}")
     gains = {k: fields.number(feedback, k, "feedback", non_negative=True, default=0.0, within=(0.0, MAX_GAIN_S, "s"))
              for k in FEEDBACK_KEYS[:4]}
-    attitude = fields.number(feedback, "attitude_gain", "feedback", non_negative=True, default=0.0,
-                             within=(0.0, 2.0, ""))
+    attitude = [fields.number(feedback, k, "feedback", non_negative=True, default=0.0, within=(0.0, 2.0, ""))
+                for k in ("attitude_roll_gain", "attitude_pitch_gain")]
     max_corr = fields.number(feedback, "max_correction_deg", "feedback", positive=True, default=8.0,
                              within=(0.0, 45.0, "deg"))
     response = fall.get("response", "torque_off")
@@ -105,7 +108,7 @@ def read_imu(fields: Any, data: dict, bus: Any) -> ImuSettings:
         raise fields.fail("fall.response", f"unknown response {response!r} (allowed: {', '.join(FALL_RESPONSES)})")
     return ImuSettings(source, device_id, mount, noise["gyro_noise_dps"], noise["gyro_bias_dps"], noise["acc_noise_g"],
                        delay, gains["ankle_pitch_s"], gains["hip_pitch_s"], gains["ankle_roll_s"], gains["hip_roll_s"],
-                       attitude, max_corr,
+                       *attitude, max_corr,
                        fields.number(fall, "tilt_deg", "fall", positive=True, default=40.0, within=(5.0, 90.0, "deg")),
                        fields.number(fall, "tilt_rate_dps", "fall", positive=True, default=250.0,
                                      within=(10.0, 2000.0, "deg/s")),

@@ -9,6 +9,7 @@ a sign or swaps two joints is refused in one line (exit 2) naming the field.
 from __future__ import annotations
 
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -23,7 +24,7 @@ except SimUnavailable:
     pytest.skip("the sim extra (MuJoCo) is not installed", allow_module_level=True)
 
 from gaitbot.app.cli import main  # noqa: E402
-from helpers import CONFIG_DIR, REPO_ROOT, config, run_cli  # noqa: E402
+from helpers import CONFIG_DIR, REPO_ROOT, config, read_lines, run_cli  # noqa: E402
 
 MAP = CONFIG_DIR / "sim-maps" / "op3-menagerie.toml"
 
@@ -131,3 +132,28 @@ def test_a_model_that_is_not_mjcf_is_one_line(tmp_path, capsys):
     assert main(["walk", "--sim", "--robot", "op3", "--sim-model", str(bad), "--sim-map", str(MAP)]) == 2
     err = capsys.readouterr().err.strip()
     assert f"--sim-model {bad}: MuJoCo cannot load it" in err and "\n" not in err
+
+
+def test_strong_feedback_with_a_push_on_the_menagerie_op3_breaks_no_limit(menagerie_xml, tmp_path, capsys):
+    """Feedback never breaks a limit, pushes included: gains far above the op3's (every damping 0.3 s, the
+    attitude 2 deg per deg in both axes, corrections up to 20 deg) on another author's model, pushed forwards
+    with 1.5 N s; whether it falls or not, `gaitbot check` passes the recording (up to the fall and its stop),
+    and the goals sent are not the open-loop walk's (the feedback acted)."""
+    text = (CONFIG_DIR / "op3.toml").read_text()
+    for key, value in (("ankle_pitch_s", "0.3"), ("hip_pitch_s", "0.3"), ("ankle_roll_s", "0.3"), ("hip_roll_s", "0.3"),
+                       ("attitude_roll_gain", "2.0"), ("attitude_pitch_gain", "2.0"), ("max_correction_deg", "20.0")):
+        text, count = re.subn(rf"^{key} = .*$", f"{key} = {value}", text, flags=re.M)
+        assert count == 1, key
+    strong = tmp_path / "op3-strong.toml"
+    strong.write_text(text)
+    goals = {}
+    for mode in ("none", "full"):
+        record = tmp_path / f"{mode}.jsonl"
+        code, out, err = run_cli(capsys, "walk", "--sim", "--json", "--robot", strong, "--sim-model", menagerie_xml,
+                                 "--sim-map", MAP, "--distance", "0.6", "--max-step", "0.05", "--cycle", "1.0",
+                                 "--push", "1.5@0", "--feedback", mode, "--record", record)
+        assert code in (0, 1), err
+        assert json.loads(out)["feedback"] == mode
+        assert run_cli(capsys, "check", "--robot", strong, record)[0] == 0
+        goals[mode] = [row["hex"] for row in read_lines(record)[1:] if row["dir"] == "tx"][:400]
+    assert goals["none"] != goals["full"]
