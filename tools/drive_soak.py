@@ -5,8 +5,9 @@
 For each robot (op3 and bioloid by default), random commands (seeded; changing every 2-5 s, uniform within the
 robot's [steer] limits on each axis, 15% of them stops) are written to a commands file and driven by
 ``gaitbot drive --sim --input commands:FILE --json``; the table gives falls, the distance walked (planned
-steps), the worst torso tilt (roll or pitch, deg), and the frames' work p50/p99 (tools/bench_drive.py's
-measure of the same commands, without the physics).
+steps), the steps the drive's step check refused, the worst torso tilt (roll or pitch, deg), how long the
+drive ran (simulated seconds: a refused frame ends it early), the IMU feedback used (the robot's default), and
+the frames' work p50/p99 (tools/bench_drive.py's measure of the same commands, without the physics).
 """
 
 from __future__ import annotations
@@ -41,7 +42,9 @@ def soak(robot: str, minutes: float, seed: int) -> dict:
     work = measure(robot, minutes, seed)
     return {"robot": robot, "fell": report["fell"], "fall_reason": report.get("fall_reason"),
             "distance_m": report["distance_m"], "steps": report["steps"], "tilt_deg": report["worst_tilt_deg"],
-            "p50_ms": work["frame_p50_ms"], "p99_ms": work["frame_p99_ms"], "exit": report["exit_status"]}
+            "p50_ms": work["frame_p50_ms"], "p99_ms": work["frame_p99_ms"], "exit": report["exit_status"],
+            "driven_s": report["frames"] / 60.0, "feedback": report["feedback"], "outcome": report["outcome"],
+            "step_refusals": report["step_refusals"], "refused": report["refused"]}
 
 
 def main() -> None:
@@ -50,13 +53,17 @@ def main() -> None:
     parser.add_argument("--minutes", type=float, default=10.0)
     parser.add_argument("--seed", type=int, default=1)
     args = parser.parse_args()
-    print(f"| robot | minutes | falls | distance m | steps | worst tilt deg | frame work p50 ms | p99 ms | exit |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| robot | feedback | driven s | falls | distance m | steps | steps refused | worst tilt deg | "
+          "frame work p50 ms | p99 ms | exit |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for robot in args.robot or ["op3", "bioloid"]:
         r = soak(robot, args.minutes, args.seed)
         fall = f"1 ({r['fall_reason']})" if r["fell"] else "0"
-        print(f"| {robot} | {args.minutes:g} | {fall} | {r['distance_m']:.2f} | {r['steps']} | {r['tilt_deg']:.1f} | "
-              f"{r['p50_ms']:.3f} | {r['p99_ms']:.3f} | {r['exit']} |", flush=True)
+        print(f"| {robot} | {r['feedback']} | {r['driven_s']:.0f} | {fall} | {r['distance_m']:.2f} | {r['steps']} | "
+              f"{r['step_refusals']} | {r['tilt_deg']:.1f} | {r['p50_ms']:.3f} | {r['p99_ms']:.3f} | {r['exit']} |",
+              flush=True)
+        if r["refused"]:
+            print(f"{robot}: {r['refused']}", file=sys.stderr, flush=True)
 
 
 if __name__ == "__main__":
