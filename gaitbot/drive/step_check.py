@@ -5,18 +5,19 @@ the step's own plan (the walker's ``preview_step``: its frames' ankles, feet yaw
 reference, computed on copies), before it is appended:
 
 * the feet's clearance: the stance sole and the swing sole along the swing's whole path keep the robot's
-  ``[steer] min_gap_m`` (gaitbot.gait.steer.soles.swept_gap_m), the planner's last resort included;
+  ``[steer] min_gap_m`` (the planner measures it for every step, its last resort included: Footstep.gap_m);
 * balance: at every frame of the step the planned ZMP lies inside the support polygon (the soles on the
   floor) by at least ZMP_MARGIN_SHARE of the sole's width;
-* limits: the legs' angles at every frame of the step (the IK of the planned ankles, the pelvis over a
-  CoM estimated as the ZMP reference averaged over one step: the preview controller's CoM is a smoothed
-  ZMP reference) inside the joints' limits, within reach, and their velocities and accelerations (finite
-  differences over the frames) within PREDICTION_SLACK of the limits.
+* limits: the legs' angles at every frame of the step, from the IK of the planned ankles with the pelvis
+  over the CoM of the linear inverted pendulum whose ZMP follows the step's reference (``lipm_com``; after
+  the step, the close the walker previews), inside the joints' limits (within ANGLE_SLACK_DEG) and within
+  reach, and their velocities and accelerations (finite differences over the frames) within
+  PREDICTION_SLACK times the limits.
 
-The limits are a prediction (the walker places the body by its two preview stages, a few millimetres
-from the estimate), so the slack lets through what the frame guard (gaitbot.drive.guard) will judge
-exactly, frame by frame; a step refused here is never appended: the drive plans a stop instead.
-Cost: one IK of the step's ~25 frames (vectorised) and a few hundred float operations (docs/driving.md).
+The limits are a prediction (the walker places the body by its two preview stages), so the slack lets
+through what the frame guard (gaitbot.drive.guard) judges exactly, frame by frame; a step refused here is
+never appended: the drive plans a stop instead. The work is split in STAGES stages, one a frame
+(python tools/step_check_accuracy.py measures the prediction's error and each stage's cost).
 """
 
 from __future__ import annotations
@@ -26,22 +27,22 @@ import math
 import numpy as np
 
 from gaitbot.gait.balance.placement import torso_yaw
-from gaitbot.gait.joints import LEG_JOINTS, SIDES
-from gaitbot.gait.mass import GRAVITY_M_S2
-from gaitbot.gait.kinematics6 import ReachError, leg_ik, rot_z
-from gaitbot.gait.steer.soles import sole_box
 from gaitbot.gait.balance.zmp_reference import FootPlacement, smootherstep, zmp_point
+from gaitbot.gait.joints import LEG_JOINTS, SIDES
+from gaitbot.gait.kinematics6 import ReachError, leg_ik, rot_z
+from gaitbot.gait.mass import GRAVITY_M_S2
+from gaitbot.gait.steer.soles import sole_box
 
 GAP_TOLERANCE_M = 1e-4
 STAGES = 3
 """Frames a live drive spends on one step's check (the plan's preview, balance, limits)."""
 ZMP_MARGIN_SHARE = 0.1
 """The planned ZMP keeps this share of the sole's width from the support polygon's edge."""
-ANGLE_SLACK_DEG = 8.0
+ANGLE_SLACK_DEG = 10.0
 """A predicted angle may pass its limit by this much (the estimate's error): the frame guard is exact."""
 PREDICTION_SLACK = 1.25
 """A predicted velocity or acceleration may reach this multiple of its limit (the estimate's error:
-measured within a factor of about 1.2 of the frames the walker sends, docs/driving.md)."""
+python tools/step_check_accuracy.py measures it: docs/driving.md)."""
 GROUNDED_M = 1e-6
 
 
