@@ -15,12 +15,11 @@ import signal
 import sys
 import threading
 
-from gaitbot.app.drive import DEFAULT_PUSH_AT_S
 from gaitbot.app.feel_options import fall_dict, fall_line, feedback_mode, make_feedback
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, load_robot
 from gaitbot.app.outputs import output_path
-from gaitbot.app.sim_options import check_sim_model, foreign_model, parse_push
+from gaitbot.app.sim_options import DEFAULT_PUSH_AT_S, check_sim_model, foreign_model, parse_push
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.recording import BusRecorder
 from gaitbot.drive.frames import DriveFrames, command_limits
