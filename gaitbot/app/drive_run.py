@@ -193,7 +193,8 @@ def _ending(outcome: str, result) -> str:
         how = "Ctrl-C" if outcome == "interrupted" else "SIGTERM"
         return "; ".join([f"Drive stopped by {how}: steps finished, feet closed, standing", *result.notes]) + "."
     if outcome == "refused":
-        return "Drive stopped: a frame was refused before it was sent; ramped to standing."
+        return ("Drive stopped: a frame (or a step, and the stop in its place) was refused before it was sent; "
+                "ended standing.")
     if outcome == "fell":
         return "; ".join(["Drive stopped: the robot fell, stepping stopped and the CoM lowered", *result.notes]) + "."
     return result.message()
@@ -204,7 +205,7 @@ def _report(args, config, frames: DriveFrames, result, first_signal, sim, feedba
     outcome = result.outcome
     if outcome == "completed" and first_signal is not None:
         outcome, exit_code = ("terminated", 143) if first_signal == signal.SIGTERM else ("interrupted", 130)
-    if outcome == "completed" and frames.log.refused:
+    if outcome == "completed" and frames.log.ended_by_refusal:  # a step replaced by a stop alone is no failure
         outcome, exit_code = "refused", 1
     x, y, heading = frames.walk_pose()
     report = {"robot": config.name, "input": args.input, "outcome": outcome,

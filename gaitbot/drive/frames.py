@@ -68,6 +68,7 @@ class DriveLog:
     clipped: bool = False
     refused: str | None = None
     step_refusals: int = 0
+    ended_by_refusal: bool = False  # a refused frame, or a step whose stop would fail too, ended the drive
     commands: list[TimedCommand] = field(default_factory=list)
     latencies_s: list[float] = field(default_factory=list)  # from a new command to the start of its first step
 
@@ -204,7 +205,7 @@ class DriveFrames:
             except StopIteration as done:
                 self._checking = None
                 if done.value is None:  # even slowing down would not pass: no more steps
-                    self.ending = True
+                    self.ending = self.log.ended_by_refusal = True
                 else:
                     self._next_step = done.value
             return
@@ -268,6 +269,7 @@ class DriveFrames:
                 self.log.heading_rad + here.yaw_rad - origin.yaw_rad)
 
     def _refuse(self, reason: str) -> None:
+        self.log.ended_by_refusal = True
         if self.log.refused is None:
             self.log.refused = reason
             self.say(reason)

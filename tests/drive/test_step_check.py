@@ -73,6 +73,7 @@ def test_a_step_onto_the_stance_foot_is_replaced_by_a_stop_said_once(monkeypatch
     refusals = [s for s in said if "replaced by a stop" in s]
     assert len(refusals) == 1 and "soles" in refusals[0] and "standing until the command changes" in refusals[0]
     assert frames.log.steps <= 6  # stopped: a slowing step, the close; no more steps under the refused command
+    assert not frames.log.ended_by_refusal  # the stop in its place passed: no failure (exit 0)
     stand = standing_ticks(config)
     assert np.array_equal(ticks[0], stand) and np.array_equal(ticks[-1], stand)
 
@@ -110,7 +111,7 @@ def test_a_step_that_would_tip_is_refused(monkeypatch):
     frames, ticks, said = drive(tipping, FORWARD)
     refusals = [s for s in said if "replaced by a stop" in s]
     assert len(refusals) == 1 and "ZMP" in refusals[0]
-    assert frames.log.steps == 0 and len(ticks) < 6 * 60
+    assert frames.log.steps == 0 and len(ticks) < 6 * 60 and frames.log.ended_by_refusal  # exit 1
     assert np.array_equal(ticks[-1], standing_ticks(config))
 
 

@@ -27,10 +27,12 @@ from gaitbot.gait.balance.zmp_reference import FootPlacement
 from gaitbot.gait.body import SIDE_SIGN, BodyGeometry
 from gaitbot.gait.steer.command import STILL, VelocityCommand
 from gaitbot.gait.steer.limits import SteerLimits
-from gaitbot.gait.steer.soles import swept_gap_m
+from gaitbot.gait.steer.soles import swept_gap_m, swept_gap_where
 
 PUSH_MARGIN_M = 5e-4  # pushed this much beyond min_gap_m (the gap is checked on a grid of swing poses)
 MAX_PUSHES = 8
+MIN_PUSH_SHARE = 0.25
+"""A gap least early in the swing is pushed for as if it were at least this share of the way (bounded pushes)."""
 MAX_HALVINGS = 4
 SETTLED = 1e-12  # a displacement or a foot offset below this is zero
 
@@ -160,24 +162,28 @@ class FootstepPlanner:
     def _clear_foothold(self, swing_side: str, forward: float, lateral: float,
                         dtheta: float) -> tuple[WalkFrame, FootPlacement, float]:
         """The new walk frame, the foothold, pushed outward (or the sideways step and turn halved) until
-        the soles keep min_gap_m over the whole swing, and that swing's least gap. The last resort (no
-        sideways step, no turn) is measured too: a caller refuses it if it still comes too close."""
+        the soles keep min_gap_m over the whole swing, and that swing's least gap: last, with no sideways
+        step and no turn, pushed outward too. The last resort (not even that) is measured as well: a caller
+        refuses it if it still comes too close."""
         g, lim = self.geometry, self.limits
         stance = self.feet["right" if swing_side == "left" else "left"]
         old = self.feet[swing_side]
-        for _ in range(MAX_HALVINGS + 1):
-            frame = self.frame.moved(forward, lateral, dtheta)
+        tries = [(lateral / 2 ** k, dtheta / 2 ** k) for k in range(MAX_HALVINGS + 1)] + [(0.0, 0.0)]
+        for n, (side_m, turn) in enumerate(tries):
+            frame = self.frame.moved(forward, side_m, turn)
             outward = 0.0
             for _ in range(MAX_PUSHES):
                 foothold = frame.foot(swing_side, self.half_width_m, outward)
-                gap = swept_gap_m(g, stance, old, foothold)
+                gap, share = swept_gap_where(g, stance, old, foothold)
                 if gap >= lim.min_gap_m:
                     return frame, foothold, gap
-                outward += lim.min_gap_m - gap + PUSH_MARGIN_M
+                # the last try (no sideways step, no turn): where the gap is least the sole moves outward by
+                # share x the push (a toe turning in early in the swing), so push that much more
+                last = n == len(tries) - 1
+                outward += (lim.min_gap_m - gap + PUSH_MARGIN_M) / (max(share, MIN_PUSH_SHARE) if last else 1.0)
                 if outward > lim.max_side_m + lim.min_gap_m:
                     break
-            lateral, dtheta = lateral / 2, dtheta / 2
-        frame = self.frame.moved(forward, 0.0, 0.0)  # last resort: no sideways step, no turn
+        frame = self.frame.moved(forward, 0.0, 0.0)  # last resort: no sideways step, no turn, no push
         foothold = frame.foot(swing_side, self.half_width_m)
         return frame, foothold, swept_gap_m(g, stance, old, foothold)
 
