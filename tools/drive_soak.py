@@ -5,7 +5,8 @@
 For each robot (op3 and bioloid by default), random commands (seeded; changing every 2-5 s, uniform within the
 robot's [steer] limits on each axis, 15% of them stops) are written to a commands file and driven by
 ``gaitbot drive --sim --input commands:FILE --json``; the table gives falls, the distance walked (planned
-steps), the steps the drive's step check refused, the worst torso tilt (roll or pitch, deg), how long the
+steps), the steps the drive's step check refused, the frames its frame check brought inside a limit by a
+hair, the worst torso tilt (roll or pitch, deg), how long the
 drive ran (simulated seconds: a refused frame ends it early), the IMU feedback used (the robot's default), and
 the frames' work p50/p99 (tools/bench_drive.py's measure of the same commands, without the physics).
 """
@@ -45,7 +46,8 @@ def soak(robot: str, minutes: float, seed: int, work: bool = True) -> dict:
             "distance_m": report["distance_m"], "steps": report["steps"], "tilt_deg": report["worst_tilt_deg"],
             "p50_ms": work["frame_p50_ms"], "p99_ms": work["frame_p99_ms"], "exit": report["exit_status"],
             "driven_s": report["frames"] / 60.0, "feedback": report["feedback"], "outcome": report["outcome"],
-            "step_refusals": report["step_refusals"], "refused": report["refused"]}
+            "step_refusals": report["step_refusals"], "refused": report["refused"],
+            "frames_clipped": report["frames_clipped"]}
 
 
 def main() -> None:
@@ -56,19 +58,20 @@ def main() -> None:
     parser.add_argument("--markdown", action="store_true", help="the table as the docs' figure block drive-soak "
                         "(without the frames' work: CPU time is not a checked figure)")
     args = parser.parse_args()
-    columns = "| robot | feedback | driven s | falls | distance m | steps | steps refused | worst tilt deg |"
+    columns = ("| robot | feedback | driven s | falls | distance m | steps | steps refused | frames clipped | "
+               "worst tilt deg |")
     if args.markdown:
         print("<!-- figure drive-soak -->")
         print(columns)
-        print("|---|---|---|---|---|---|---|---|")
+        print("|---|---|---|---|---|---|---|---|---|")
     else:
         print(columns + " frame work p50 ms | p99 ms | exit |")
-        print("|---|---|---|---|---|---|---|---|---|---|---|")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for robot in args.robot or ["op3", "bioloid"]:
         r = soak(robot, args.minutes, args.seed, work=not args.markdown)
         fall = f"1 ({r['fall_reason']})" if r["fell"] else "0"
         row = (f"| {robot} | {r['feedback']} | {r['driven_s']:.0f} | {fall} | {r['distance_m']:.2f} | {r['steps']} | "
-               f"{r['step_refusals']} | {r['tilt_deg']:.1f} |")
+               f"{r['step_refusals']} | {r['frames_clipped']} | {r['tilt_deg']:.1f} |")
         print(row if args.markdown else row + f" {r['p50_ms']:.3f} | {r['p99_ms']:.3f} | {r['exit']} |", flush=True)
         if r["refused"]:
             print(f"{robot}: {r['refused']}", file=sys.stderr, flush=True)

@@ -212,6 +212,7 @@ def _report(args, config, frames: DriveFrames, result, first_signal, sim, feedba
               "pose": {"x_m": x, "y_m": y, "heading_deg": math.degrees(heading)},
               "distance_m": frames.log.distance_m, "steps": frames.log.steps, "clipped": frames.log.clipped,
               "refused": frames.log.refused, "step_refusals": frames.log.step_refusals,
+              "frames_clipped": frames.guard.clipped,
               "fell": outcome == "fell", "frames": frames.k, "feedback": feedback.mode if feedback else "none",
               "fall_noticed": fall_dict(result, sim.tilt_crossed_s(config.imu.fall_tilt_deg) if sim else None),
               "notes": list(result.notes), "error": str(result.error) if result.error else None}

@@ -145,11 +145,14 @@ class DriveFrames:
         if frame is None:  # the walker has closed its feet and lowered to standing
             self._close_walker()
             return self.__next__() if self.ending else self._hand_out(self.stand)
-        reason = self.guard.check(frame[2])
+        clipped = self.guard.clipped
+        goal, reason = self.guard.admit(frame[2])
         if reason is not None:
             self._refuse(f"frame at {t_s:.2f} s refused: {reason}")
             return self._from_ramp()
-        return self._hand_out(self.config.calibration.angles_to_ticks(frame[2], LEG_JOINTS))
+        if self.guard.clipped > clipped and clipped == 0:
+            self.say(f"frame at {t_s:.2f} s brought inside a joint's limits by a hair (said once; --json counts them)")
+        return self._hand_out(self.config.calibration.angles_to_ticks(goal, LEG_JOINTS))
 
     def _hand_out(self, ticks: np.ndarray) -> np.ndarray:
         self._sent = [self._sent[1], ticks]

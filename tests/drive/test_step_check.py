@@ -156,3 +156,28 @@ def test_ordinary_steps_carry_their_gap():
     for side in ("left", "right", "left", "right"):
         step = planner.next_step(VelocityCommand(0.0, 0.02, 10.0), side)
         assert config.steer.min_gap_m <= step.gap_m < math.inf
+
+
+def test_a_frame_beyond_a_limit_by_a_hair_is_brought_inside_and_more_is_refused():
+    """The frame guard's window: a velocity 0.5% over the limit (the walker's rounding at a limit) is clipped to
+    the limit and counted; 5% over is refused."""
+    from gaitbot.drive.guard import FrameGuard
+
+    config = load_robot("bioloid")
+    guard = FrameGuard(config, 1 / 60)
+    guard.reset(np.zeros(12))
+    step = guard.max_velocity[3] / 60
+    hair = np.zeros(12)
+    hair[3] = 1.005 * step * 0.1  # a gentle start first (inside the acceleration limit)
+    sent, reason = guard.admit(hair)
+    assert reason is None and guard.clipped == 0
+    guard.reset(np.zeros(12))
+    guard.max_accel[:] = np.inf  # velocity alone
+    over = np.zeros(12)
+    over[3] = 1.005 * step
+    sent, reason = guard.admit(over)
+    assert reason is None and guard.clipped == 1 and abs(sent[3]) <= step
+    guard.reset(np.zeros(12))
+    over[3] = 1.05 * step
+    sent, reason = guard.admit(over)
+    assert sent is None and "deg/s" in reason
