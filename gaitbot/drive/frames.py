@@ -7,9 +7,12 @@
 2. the command is clipped to the robot's ``[steer]`` limits (said once per drive);
 3. while the walker has fewer than ``queue_steps`` steps planned that have not started, ONE step is
    planned from the latest command (gaitbot.gait.steer.planner: per-step limits and change limits, the
-   soles' swept gap) and its clearance checked again here; a step that fails is replaced by a stop;
+   soles' swept gap) and checked before the walker gets it (gaitbot.drive.step_check: the gap, the planned
+   ZMP inside the support polygon, the legs' predicted angles, velocities and accelerations; a stage a
+   frame); a step that fails is replaced by a stop and the drive stands until the command changes;
 4. the balanced walker computes the frame; the FrameGuard checks it (limits, velocity, acceleration)
-   before it is sent; a frame that fails is replaced by the session's stop ramp and the drive ends;
+   before it is sent: a frame outside by a hair is brought inside, one that fails is replaced by the
+   session's stop ramp and the drive ends;
 5. the angles become ticks through the robot's calibration.
 A still command with the feet side by side stops stepping: the walker closes its feet, lowers to the
 standing pose and the drive holds standing until a command moves it again (a new walker, from standing).
@@ -191,8 +194,8 @@ class DriveFrames:
 
     def _plan_ahead(self) -> None:
         """At most one piece of planning a frame, while fewer than queue_steps planned steps have not
-        started: a step is planned in one frame, checked over the next CHECK_FRAMES (gaitbot.drive.step_check,
-        a stage a frame) and handed to the walker in the frame after (spreading the work)."""
+        started: a step is planned in one frame, checked over the next step_check.STAGES frames (a stage a
+        frame) and handed to the walker in the frame after (spreading the work)."""
         walker, planner = self._walker, self._planner
         if self._next_step is not None:
             step, self._next_step = self._next_step, None

@@ -3,8 +3,9 @@
 Preflight cannot see a live walk's future, so each frame the walker computes is checked here, in angles
 (no tick rounding), against the same joint limits ``gaitbot check`` uses: position (min/max_deg),
 velocity (max_velocity_dps) and acceleration (max_acceleration_dps2) from the two frames before it. A frame
-that fails is never sent: the drive replaces the rest of the walk by the session's stop ramp from the last
-frame that passed (gaitbot.stream.ramps.stop_ticks, itself within the limits).
+outside that window by a hair (CLIP_SHARE of a frame's largest step) is brought to its edge (``admit``); a
+frame that fails by more is never sent: the drive replaces the rest of the walk by the session's stop ramp
+from the last frame that passed (gaitbot.stream.ramps.stop_ticks, itself within the limits).
 """
 
 from __future__ import annotations
