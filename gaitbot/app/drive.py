@@ -4,6 +4,8 @@ hands the drive to gaitbot.app.drive_run (numpy, the walker, the bus). docs/driv
 from __future__ import annotations
 
 from gaitbot.app.arguments import add_command
+from gaitbot.app.feel_options import add_feedback_option
+from gaitbot.app.sim_options import DEFAULT_PUSH_AT_S, add_sim_model_options
 from gaitbot.app.view_options import add_view_options
 
 
@@ -19,6 +21,10 @@ def add_parser(subparsers):
     p.add_argument("--dry-run", action="store_true", help="drive the mock bus under the real SDK: no hardware")
     p.add_argument("--sim", action="store_true", help="drive the simulated robot (MuJoCo, free-floating)")
     p.add_argument("--realtime", action="store_true", help="--dry-run: pace it at the real frame rate")
+    add_sim_model_options(p, "at --push-at")  # --push, --imu-fault, --imu-seed, --sim-model, --sim-map (gaitbot.app.sim_options)
+    p.add_argument("--push-at", type=float, metavar="S", help=f"--sim --push: when the push starts, in seconds "
+                   f"from the start of the drive (default {DEFAULT_PUSH_AT_S:g})")
+    add_feedback_option(p)  # --feedback (gaitbot.app.feel_options)
     p.add_argument("--record", metavar="FILE", help="write every bus packet to this .jsonl file (gaitbot check reads it)")
     p.add_argument("--record-commands", metavar="FILE", help="write the commands received (JSON Lines, as "
                    "--input commands:FILE and --commands read them)")

@@ -15,9 +15,11 @@ import signal
 import sys
 import threading
 
+from gaitbot.app.feel_options import fall_dict, fall_line, feedback_mode, make_feedback
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.options import UsageError, load_robot
 from gaitbot.app.outputs import output_path
+from gaitbot.app.sim_options import DEFAULT_PUSH_AT_S, check_sim_model, foreign_model, parse_push
 from gaitbot.app.view_options import FOXGLOVE_INPUT, drive_input, open_drive_view
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.recording import BusRecorder
@@ -45,6 +47,16 @@ def _check_args(args) -> None:
     for flag in ("record", "record_commands"):
         if getattr(args, flag):
             output_path(getattr(args, flag), f"--{flag.replace('_', '-')}", args)
+    if not args.sim:
+        for flag in ("push", "push_at", "imu_fault", "sim_model", "sim_map"):
+            if getattr(args, flag, None) is not None:
+                raise UsageError(f"--{flag.replace('_', '-')}: only with --sim (a simulated drive)")
+    args.push, args.push_direction_deg = parse_push(args.push)
+    if args.push_at is not None and not (math.isfinite(args.push_at) and 0 <= args.push_at <= MAX_TIME_S):
+        raise UsageError(f"--push-at must be seconds from the start, 0 to {MAX_TIME_S:g}, got {args.push_at!r}")
+    if args.push_at is not None and args.push is None:
+        raise UsageError("--push-at: give the push too (--push IMPULSE[@DIRECTION])")
+    check_sim_model(args)
 
 
 class GracefulSignals:
@@ -104,6 +116,7 @@ def run(args) -> int:
     config = load_robot(args.robot, getattr(args, "calibration", None))
     if config.steer is None:
         raise UsageError(f"--robot {args.robot or config.name}: {config.name} has no [steer] table: it cannot be driven")
+    mode = feedback_mode(args, config)  # refused (one line) before anything is opened; no IMU: said once
     step_s = footstep_planner(config).step_s
     top, bottom = command_limits(config.steer, step_s)
     view = open_drive_view(args, config)  # --mcap, --foxglove (gaitbot.app.view_options)
@@ -112,7 +125,7 @@ def run(args) -> int:
                         if args.record_commands else None)
         source = view.teleop if args.input == FOXGLOVE_INPUT else open_source(args.input, top, bottom)
         try:
-            return _drive(args, config, source, commands_out, view)
+            return _drive(args, config, source, commands_out, mode, view)
         finally:
             source.close()
             if commands_out is not None:
@@ -122,7 +135,7 @@ def run(args) -> int:
             view.close()
 
 
-def _drive(args, config, source, commands_out, view=None) -> int:
+def _drive(args, config, source, commands_out, mode: str, view=None) -> int:
     def on_command(timed) -> None:
         if commands_out is not None:
             commands_out.write(timed.to_json() + "\n")
@@ -150,19 +163,20 @@ def _drive(args, config, source, commands_out, view=None) -> int:
         raise UsageError(f"--record {args.record}: cannot write the recording ({exc.strerror or exc})") from None
     velocity, acceleration = joint_limits_ticks(config)
     health = HealthMonitor.for_robot(config, _say, clock.now)
+    feedback = make_feedback(config, mode, bus, clock, frames.period_s)
     try:
         with GracefulSignals(frames) as signals:
             result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
                                   max_accel_ticks_per_s2=acceleration, period_s=frames.period_s, clock=clock,
                                   torque_off_on_exit=config.bus.torque_off_on_exit,
                                   on_frame=_on_frame(view, frames, health, clock), handle_sigterm=False,
-                                  setup_writes=gain_writes(config), health=health)
+                                  setup_writes=gain_writes(config), health=health, feedback=feedback)
     finally:
         if recorder is not None:
             recorder.close()
     if sys.stderr.isatty():
         print(file=sys.stderr)
-    return _report(args, config, frames, result, signals.first, sim)
+    return _report(args, config, frames, result, signals.first, sim, feedback)
 
 
 def _on_frame(view, frames: DriveFrames, health: HealthMonitor, clock):
@@ -180,11 +194,19 @@ def _from_zero(clock):
 
 def _sim_walk(args, config, frames: DriveFrames):
     from gaitbot.sim.metrics import WalkPlan
-    from gaitbot.sim.walk import SimWalk
+    from gaitbot.sim.walk import Push, Pusher, SimWalk
 
     start = {name: 0.0 for name in config.walking_joint_names}
     plan = WalkPlan(distance_m=0.0, start_angles_rad=start, start_root_m=frames.start_root_m)
-    return SimWalk(config, 1.0 / frames.period_s, plan, "free")
+    sim = SimWalk(config, 1.0 / frames.period_s, plan, "free", foreign=foreign_model(args), imu_seed=args.imu_seed,
+                  imu_fault=args.imu_fault)
+    for note in getattr(sim.robot, "notes", ()):
+        print(f"note: --sim-model: {note}", file=sys.stderr)
+    if args.push is not None:  # a drive has no planned middle step: the push comes at --push-at
+        at_s = DEFAULT_PUSH_AT_S if args.push_at is None else args.push_at
+        sim.push = Push(args.push, at_s, 0, "", args.push_direction_deg)
+        sim.robot.observers.append(Pusher(sim.push, sim.robot.frame_s))
+    return sim
 
 
 def _ending(outcome: str, result) -> str:
@@ -193,30 +215,39 @@ def _ending(outcome: str, result) -> str:
         how = "Ctrl-C" if outcome == "interrupted" else "SIGTERM"
         return "; ".join([f"Drive stopped by {how}: steps finished, feet closed, standing", *result.notes]) + "."
     if outcome == "refused":
-        return "Drive stopped: a frame was refused before it was sent; ramped to standing."
+        return ("Drive stopped: a frame (or a step, and the stop in its place) was refused before it was sent; "
+                "ended standing.")
+    if outcome == "fell":
+        return "; ".join(["Drive stopped: the robot fell, stepping stopped and the CoM lowered", *result.notes]) + "."
     return result.message()
 
 
-def _report(args, config, frames: DriveFrames, result, first_signal, sim) -> int:
+def _report(args, config, frames: DriveFrames, result, first_signal, sim, feedback) -> int:
     exit_code = result.exit_code
     outcome = result.outcome
     if outcome == "completed" and first_signal is not None:
         outcome, exit_code = ("terminated", 143) if first_signal == signal.SIGTERM else ("interrupted", 130)
-    if outcome == "completed" and frames.log.refused:
+    if outcome == "completed" and frames.log.ended_by_refusal:  # a step replaced by a stop alone is no failure
         outcome, exit_code = "refused", 1
     x, y, heading = frames.walk_pose()
     report = {"robot": config.name, "input": args.input, "outcome": outcome,
               "pose": {"x_m": x, "y_m": y, "heading_deg": math.degrees(heading)},
               "distance_m": frames.log.distance_m, "steps": frames.log.steps, "clipped": frames.log.clipped,
-              "refused": frames.log.refused, "fell": False, "frames": frames.k,
+              "refused": frames.log.refused, "step_refusals": frames.log.step_refusals,
+              "frames_clipped": frames.guard.clipped,
+              "fell": outcome == "fell", "frames": frames.k, "feedback": feedback.mode if feedback else "none",
+              "fall_noticed": fall_dict(result, sim.tilt_crossed_s(config.imu.fall_tilt_deg) if sim else None),
               "notes": list(result.notes), "error": str(result.error) if result.error else None}
     if sim is not None:
         measured = sim.report()
         report["planned_pose"] = report["pose"]
         report["pose"] = {"x_m": measured.distance_travelled_m, "y_m": measured.lateral_drift_m,
                           "heading_deg": measured.heading_deg}
-        report["fell"] = measured.fell
-        report["fall_reason"] = measured.fall_reason
+        report["fell"] = measured.fell or report["fell"]
+        report["fall_reason"] = measured.fall_reason or (str(result.error) if outcome == "fell" else None)
+        report["fell_at_s"] = measured.fell_at_s
+        report["fall_direction"] = measured.fall_direction
+        report["push"] = sim.push.to_dict() if sim.push is not None else None
         report["worst_tilt_deg"] = max(measured.torso_roll_max_deg, measured.torso_pitch_max_deg)
         if measured.fell and exit_code == 0:
             exit_code = 1
@@ -228,6 +259,10 @@ def _report(args, config, frames: DriveFrames, result, first_signal, sim) -> int
         print(f"{config.name}: drove {report['steps']} steps, {report['distance_m']:.3f} m; pose x {p['x_m']:.3f} m, "
               f"y {p['y_m']:.3f} m, heading {p['heading_deg']:.1f} deg{'; FELL' if report['fell'] else ''}. "
               f"{_ending(outcome, result)}")
+        if fall_line(result, feedback):
+            print(fall_line(result, feedback))
+        elif report["fell"] and sim is not None:
+            print(f"The robot fell {report['fall_direction']} at {report['fell_at_s']:.2f} s ({report['fall_reason']}).")
     return exit_code
 
 

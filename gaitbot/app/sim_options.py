@@ -11,13 +11,17 @@ from gaitbot.app.options import UsageError, file_option
 MAX_PUSH_NS = 20.0
 """The largest --push (N s): far beyond what knocks over any small humanoid (docs/simulation.md)."""
 
+DEFAULT_PUSH_AT_S = 3.0
+"""A drive has no planned middle: its --push comes this long after the start unless --push-at says."""
+
 PUSH_LEFT_DEG = 90.0
 """Without @DIRECTION a push is sideways, to the left (a negative impulse: to the right)."""
 
 
-def add_sim_model_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--push", metavar="N_S[@DEG]", help="--sim: push the torso with this impulse (N s) in the middle "
-                   "of a step half-way through the walk; @DEG: its direction in degrees from forward, counter-clockwise "
+def add_sim_model_options(p: argparse.ArgumentParser,
+                          when: str = "in the middle of a step half-way through the walk") -> None:
+    p.add_argument("--push", metavar="N_S[@DEG]", help=f"--sim: push the torso with this impulse (N s) {when}; "
+                   "@DEG: its direction in degrees from forward, counter-clockwise "
                    "(default 90: to the left; a negative impulse pushes the opposite way)")
     p.add_argument("--imu-fault", choices=("frozen", "noisy", "absent"), help="--sim: break the simulated IMU 1 s "
                    "into the walk (docs/feedback.md says what the walk does then)")

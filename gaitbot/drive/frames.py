@@ -7,9 +7,12 @@
 2. the command is clipped to the robot's ``[steer]`` limits (said once per drive);
 3. while the walker has fewer than ``queue_steps`` steps planned that have not started, ONE step is
    planned from the latest command (gaitbot.gait.steer.planner: per-step limits and change limits, the
-   soles' swept gap) and its clearance checked again here; a step that fails is replaced by a stop;
+   soles' swept gap) and checked before the walker gets it (gaitbot.drive.step_check: the gap, the planned
+   ZMP inside the support polygon, the legs' predicted angles, velocities and accelerations; a stage a
+   frame); a step that fails is replaced by a stop and the drive stands until the command changes;
 4. the balanced walker computes the frame; the FrameGuard checks it (limits, velocity, acceleration)
-   before it is sent; a frame that fails is replaced by the session's stop ramp and the drive ends;
+   before it is sent: a frame outside by a hair is brought inside, one that fails is replaced by the
+   session's stop ramp and the drive ends;
 5. the angles become ticks through the robot's calibration.
 A still command with the feet side by side stops stepping: the walker closes its feet, lowers to the
 standing pose and the drive holds standing until a command moves it again (a new walker, from standing).
@@ -25,10 +28,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gaitbot.drive.guard import FrameGuard
+from gaitbot.drive.step_check import StepCheck
 from gaitbot.gait.joints import LEG_JOINTS
 from gaitbot.gait.steer.command import STILL, TimedCommand, VelocityCommand
 from gaitbot.gait.steer.planner import frame_of, leading_side
-from gaitbot.gait.steer.soles import swept_gap_m
 from gaitbot.robot.balanced_walk import balanced_gait_settings, balanced_walker
 from gaitbot.robot.calibration import standing_ticks
 from gaitbot.robot.steered_walk import footstep_planner
@@ -38,7 +41,6 @@ from gaitbot.stream.ramps import stop_ticks
 QUEUE_STEPS = 1
 """Steps planned ahead that have not started: 1 is the least latency (a command shows in the next step that
 starts after the one already planned); the walker previews beyond it the close-and-stand it would do."""
-GAP_TOLERANCE_M = 1e-4
 
 
 def command_limits(limits, step_s: float) -> tuple[VelocityCommand, VelocityCommand]:
@@ -67,6 +69,8 @@ class DriveLog:
     steps: int = 0
     clipped: bool = False
     refused: str | None = None
+    step_refusals: int = 0
+    ended_by_refusal: bool = False  # a refused frame, or a step whose stop would fail too, ended the drive
     commands: list[TimedCommand] = field(default_factory=list)
     latencies_s: list[float] = field(default_factory=list)  # from a new command to the start of its first step
 
@@ -86,6 +90,7 @@ class DriveFrames:
         self.say = say
         self.on_command = on_command
         self.guard = FrameGuard(config, self.period_s)
+        self.step_check = StepCheck(config, self.period_s)
         self.guard.reset(np.zeros(len(LEG_JOINTS)))
         self.stand = standing_ticks(config)
         self.velocity_ticks, self.accel_ticks = joint_limits_ticks(config)
@@ -95,6 +100,7 @@ class DriveFrames:
         self.stop_requested = False
         self.command = STILL
         self._received: VelocityCommand | None = None
+        self._refused_command: VelocityCommand | None = None  # a step under it was refused: stand until it changes
         self._changed_s: float | None = None
         self._walker_k0 = 0
         self._walker = None
@@ -114,7 +120,9 @@ class DriveFrames:
         """A walker standing where the drive stands (its own world; the odometry composes it)."""
         self._walker = balanced_walker(self.config, self.gait)
         self._next_step = None
+        self._checking = None
         self._planner = footstep_planner(self.config, self.gait)
+        self._before_check = self._planner
         self._origin = frame_of(self._walker.feet)
         self._started = False
 
@@ -133,17 +141,20 @@ class DriveFrames:
             walker.lead_with(leading_side(self.command))
             self._started = True
             self._walker_k0 = self.k
-        if not self._plan_ahead():  # a frame that appends a step leaves the replan's share for the next
+        if not self._plan_ahead():  # a frame that plans, checks or appends a step leaves the replan's share for the next
             walker.work()  # a share of the last append's replan (BalancedWalker.work)
         frame = walker.next_frame()
         if frame is None:  # the walker has closed its feet and lowered to standing
             self._close_walker()
             return self.__next__() if self.ending else self._hand_out(self.stand)
-        reason = self.guard.check(frame[2])
+        clipped = self.guard.clipped
+        goal, reason = self.guard.admit(frame[2])
         if reason is not None:
             self._refuse(f"frame at {t_s:.2f} s refused: {reason}")
             return self._from_ramp()
-        ticks = self._hand_out(self.config.calibration.angles_to_ticks(frame[2], LEG_JOINTS))
+        if self.guard.clipped > clipped and clipped == 0:
+            self.say(f"frame at {t_s:.2f} s brought inside a joint's limits by a hair (said once; --json counts them)")
+        ticks = self._hand_out(self.config.calibration.angles_to_ticks(goal, LEG_JOINTS))
         self._body = frame
         return ticks
 
@@ -171,7 +182,9 @@ class DriveFrames:
         if end and not self.ending:
             self.ending = True
             self._record(TimedCommand(round(t_s, 6), stop=True))
-        command = STILL if self.ending else clipped
+        if self._refused_command is not None and clipped != self._refused_command:
+            self._refused_command = None
+        command = STILL if self.ending or clipped == self._refused_command else clipped
         if command != self.command:
             self._changed_s = t_s
         self.command = command
@@ -182,9 +195,10 @@ class DriveFrames:
             self.on_command(timed)
 
     def _plan_ahead(self) -> bool:
-        """At most one step a frame, while fewer than queue_steps planned steps have not started; a step is
-        planned and checked in one frame and handed to the walker in the next (spreading the work).
-        Returns whether a step was handed to the walker."""
+        """At most one piece of planning a frame, while fewer than queue_steps planned steps have not
+        started: a step is planned in one frame, checked over the next step_check.STAGES frames (a stage a
+        frame) and handed to the walker in the frame after (spreading the work). Returns whether this frame
+        did a piece of that work (the walker's spread replan then waits for the next frame)."""
         walker, planner = self._walker, self._planner
         if self._next_step is not None:
             step, self._next_step = self._next_step, None
@@ -192,6 +206,19 @@ class DriveFrames:
                 self._append(step)
                 return True
             return False
+        if self._checking is not None:
+            if walker.finished or self.ending:  # dropped: the planner forgets the step
+                self._checking, self._planner = None, self._before_check
+                return False
+            try:
+                next(self._checking)
+            except StopIteration as done:
+                self._checking = None
+                if done.value is None:  # even slowing down would not pass: no more steps
+                    self.ending = self.log.ended_by_refusal = True
+                else:
+                    self._next_step = done.value
+            return True
         if walker.finished or self.ending:
             return False
         if self.command.is_still and planner.standing():
@@ -200,32 +227,30 @@ class DriveFrames:
         pending = sum(1 for s in walker.planned_steps[-self.queue_steps - 1:] if s.start_s >= now_s)
         if pending >= self.queue_steps:
             return False
-        side = walker.next_swing_side
-        step = self._checked_step(side, self.command)
-        if step is None:  # even slowing down would not keep the soles apart: no more steps
-            self.ending = True
-            return False
-        self._next_step = step
-        return False
+        self._before_check = planner.copy()
+        self._checking = self._checked_step(walker.next_swing_side, self.command)
+        next(self._checking)
+        return True
 
     def _checked_step(self, side: str, command: VelocityCommand):
-        """The planner's next step, its soles' swept gap checked again; a step that fails is replaced by a
-        slowing-down step (the still command, within the change limits) planned from the state before it,
-        and if that fails too, by None (a stop: the walker closes the feet)."""
-        planner = self._planner
-        before = planner.copy()
-        stance = planner.feet["right" if side == "left" else "left"]
-        old = planner.feet[side]
+        """A generator, one stage a frame: the planner's next step, then its check before the walker gets it
+        (gaitbot.drive.step_check: the soles' swept gap, the planned ZMP inside the support polygon, the
+        legs' angles, velocities and accelerations); returns the step. A step that fails is replaced by a
+        stop: a slowing-down step (the still command, within the change limits) planned from the state
+        before it, and the drive stands until the command changes; if that fails too, None (the walker
+        closes the feet and the drive ends). The first refusal is said once."""
         for attempt in (command, STILL):
-            step = planner.next_step(attempt, side)
-            gap = swept_gap_m(self.config.body.geometry, stance, old, step.foothold)
-            if gap >= self.config.steer.min_gap_m - GAP_TOLERANCE_M:
+            step = self._planner.next_step(attempt, side)
+            yield
+            reason = yield from self.step_check.stages(self._walker, step)
+            if reason is None:
                 return step
-            reason = f"a step would bring the soles {gap * 1e3:.1f} mm apart: replaced by a stop"
+            self.log.step_refusals += 1
+            self._refused_command = command
             if self.log.refused is None:
-                self.log.refused = reason
-                self.say(reason + " (said once)")
-            self._planner = planner = before.copy()
+                self.log.refused = f"a step at {self.k * self.period_s:.2f} s {reason}: replaced by a stop"
+                self.say(self.log.refused + "; standing until the command changes (said once)")
+            self._planner = self._before_check.copy()
         return None
 
     def _append(self, step) -> None:
@@ -269,6 +294,7 @@ class DriveFrames:
         return self._sent[1], q, world, heading + yaw - origin.yaw_rad
 
     def _refuse(self, reason: str) -> None:
+        self.log.ended_by_refusal = True
         if self.log.refused is None:
             self.log.refused = reason
             self.say(reason)

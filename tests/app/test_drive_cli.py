@@ -159,9 +159,51 @@ def test_a_udp_sender_drives_and_its_silence_stands_the_robot(tmp_path):
     (["--input", "commands:/nonexistent/c.jsonl"], "/nonexistent/c.jsonl"),
     (["--max-time", "-1", "--input", "commands:config/commands/drive-demo.jsonl"], "--max-time"),
     (["--robot", "xl430-biped", "--input", "commands:config/commands/drive-demo.jsonl"], "[steer]"),
+    (["--push", "1", "--input", "commands:config/commands/drive-demo.jsonl"], "--push: only with --sim"),
+    (["--robot", "bioloid", "--feedback", "gyro", "--input", "commands:config/commands/drive-demo.jsonl"],
+     "has no IMU"),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, words):
     result = gaitbot("drive", "--dry-run", *(["--robot", "op3"] if "--robot" not in args else []), *args)
     assert result.returncode == 2, result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and words in lines[0] and "Traceback" not in result.stderr
+
+
+def test_a_fall_in_a_drive_is_noticed_stops_and_exits_1_with_when_and_which_way(tmp_path):
+    """A 3 N s push to the left 3 s into a simulated drive (IMU feedback on, as by default): the IMU notices the
+    fall within 100 ms of the true tilt crossing the threshold, the drive stops stepping, lowers the CoM and
+    exits 1 saying when and which way, in --json too; the recording up to the fall passes gaitbot check."""
+    pytest.importorskip("mujoco")
+    path = commands_file(tmp_path, "forward", [{"t": 0.0, "vx": 0.04, "vy": 0.0, "wz": 0.0}, {"t": 8.0, "stop": True}])
+    record = tmp_path / "fall.jsonl"
+    result = gaitbot("drive", "--robot", "op3", "--sim", "--input", f"commands:{path}", "--push", "3", "--push-at",
+                     "3", "--json", "--record", str(record))
+    assert result.returncode == 1, result.stderr
+    report = json.loads(result.stdout)
+    assert report["outcome"] == "fell" and report["fell"] is True and report["exit_status"] == 1
+    assert report["feedback"] == "full"
+    fall = report["fall_noticed"]
+    assert fall["direction"] == "sideways (left)" and 3.0 < fall["t_s"] < 4.0
+    assert 0 <= fall["t_s"] - fall["true_tilt_crossed_s"] <= 0.1
+    check_ok(record)
+    result = gaitbot("drive", "--robot", "op3", "--sim", "--input", f"commands:{path}", "--push", "3", "--push-at", "3")
+    assert result.returncode == 1
+    assert "The robot fell sideways (left) at" in result.stdout and "noticed by the IMU" in result.stdout
+
+
+@pytest.mark.parametrize("robot, feedback", [("op3", "full"), ("bioloid", "none")])
+def test_a_simulated_drive_reports_pose_distance_heading_and_no_fall(tmp_path, robot, feedback):
+    """``drive --sim --input commands:FILE --json`` on both robots: the measured final pose, the distance, the
+    heading and the fall flag; the IMU feedback as the robot allows (the bioloid has no IMU: said once)."""
+    pytest.importorskip("mujoco")
+    path = commands_file(tmp_path, "arc", [{"t": 0.0, "vx": 0.03, "vy": 0.0, "wz": 8.0}, {"t": 6.0, "stop": True}])
+    result = gaitbot("drive", "--robot", robot, "--sim", "--input", f"commands:{path}", "--json")
+    assert result.returncode == 0, result.stderr
+    report = json.loads(result.stdout)
+    assert report["fell"] is False and report["fall_noticed"] is None and report["feedback"] == feedback
+    assert set(report["pose"]) == {"x_m", "y_m", "heading_deg"} and report["distance_m"] > 0.05
+    cx, cy, ch = commanded_pose(CommandSchedule.of(read_commands(path), str(path)))
+    assert math.hypot(report["pose"]["x_m"] - cx, report["pose"]["y_m"] - cy) <= 0.25 * math.hypot(cx, cy)
+    assert abs(report["pose"]["heading_deg"] - ch) <= 0.25 * abs(ch) + 2.0
+    assert result.stderr.count("has no IMU") == (1 if feedback == "none" else 0)

@@ -221,6 +221,21 @@ class BalancedWalker(Lookahead):
         """Frames of the balance plan so far (the walk's, without the rise and the lowering)."""
         return self._committed
 
+    def preview_step(self, foothold: FootPlacement, length_m: float = 0.0,
+                     before_frames: int = 0) -> tuple[dict, int, int]:
+        """The plan arrays (PLAN_KEYS) of the last ``before_frames`` frames planned, one more step to
+        ``foothold`` and the provisional close-and-stand after it (what the walker previews when no other
+        step follows), computed on copies: the walker does not change (a live drive checks a step this way
+        before it appends it). Returns (arrays, first, end): the step's own frames are
+        ``arrays[key][first:end]``."""
+        blocks, state = PlanBlocks(), self._state.copy()
+        self.planner.step_to(blocks, state, foothold, float(length_m))
+        n = blocks.frames
+        new = blocks.arrays()
+        before = min(int(before_frames), len(self._arrays["zmp"]))
+        arrays = {k: np.concatenate([self._arrays[k][len(self._arrays[k]) - before:], new[k]]) for k in new}
+        return arrays, before, before + n
+
     def lead_with(self, side: str) -> None:
         """Make ``side`` the first foot to swing (a sidestep or a turn leads with the foot on its side)."""
         if self.planned_steps:

@@ -27,10 +27,12 @@ from gaitbot.gait.balance.zmp_reference import FootPlacement
 from gaitbot.gait.body import SIDE_SIGN, BodyGeometry
 from gaitbot.gait.steer.command import STILL, VelocityCommand
 from gaitbot.gait.steer.limits import SteerLimits
-from gaitbot.gait.steer.soles import swept_gap_m
+from gaitbot.gait.steer.soles import swept_gap_m, swept_gap_where
 
 PUSH_MARGIN_M = 5e-4  # pushed this much beyond min_gap_m (the gap is checked on a grid of swing poses)
 MAX_PUSHES = 8
+MIN_PUSH_SHARE = 0.25
+"""A gap least early in the swing is pushed for as if it were at least this share of the way (bounded pushes)."""
 MAX_HALVINGS = 4
 SETTLED = 1e-12  # a displacement or a foot offset below this is zero
 
@@ -40,7 +42,8 @@ class Footstep:
     """One planned step: the swing foot's foothold (world), its displacement from the stance foot in the
     stance foot's frame (dx_m forward, dy_m left, dtheta_deg counter-clockwise), the walk's displacement
     per step it carries (forward_m, side_m, turn_deg, after the limits), the command it was planned from,
-    and whether the limits clipped that command."""
+    whether the limits clipped that command, and the least gap between the soles over the swing (m: the
+    planner keeps it at least min_gap_m, and says here what it got, its last resort included)."""
 
     foothold: FootPlacement
     dx_m: float
@@ -51,6 +54,7 @@ class Footstep:
     turn_deg: float
     command: VelocityCommand
     clipped: bool
+    gap_m: float = math.inf
 
     @property
     def length_m(self) -> float:
@@ -146,36 +150,42 @@ class FootstepPlanner:
         sign = SIDE_SIGN[swing_side]
         lateral = side if side * sign > 0 else 0.0
         dtheta = turn if turn * sign > 0 else 0.0
-        frame, foothold = self._clear_foothold(swing_side, forward, lateral, dtheta)
+        frame, foothold, gap = self._clear_foothold(swing_side, forward, lateral, dtheta)
         self.frame = frame
         stance = self.feet["right" if swing_side == "left" else "left"]
         self.feet[swing_side] = foothold
         c, s = math.cos(stance.yaw_rad), math.sin(stance.yaw_rad)
         ex, ey = foothold.x_m - stance.x_m, foothold.y_m - stance.y_m
         return Footstep(foothold, c * ex + s * ey, -s * ex + c * ey, math.degrees(foothold.yaw_rad - stance.yaw_rad),
-                        forward, side, math.degrees(turn), command, clipped)
+                        forward, side, math.degrees(turn), command, clipped, gap)
 
     def _clear_foothold(self, swing_side: str, forward: float, lateral: float,
-                        dtheta: float) -> tuple[WalkFrame, FootPlacement]:
-        """The new walk frame and the foothold, pushed outward (or the sideways step and turn halved) until
-        the soles keep min_gap_m over the whole swing."""
+                        dtheta: float) -> tuple[WalkFrame, FootPlacement, float]:
+        """The new walk frame, the foothold, pushed outward (or the sideways step and turn halved) until
+        the soles keep min_gap_m over the whole swing, and that swing's least gap: last, with no sideways
+        step and no turn, pushed outward too. The last resort (not even that) is measured as well: a caller
+        refuses it if it still comes too close."""
         g, lim = self.geometry, self.limits
         stance = self.feet["right" if swing_side == "left" else "left"]
         old = self.feet[swing_side]
-        for _ in range(MAX_HALVINGS + 1):
-            frame = self.frame.moved(forward, lateral, dtheta)
+        tries = [(lateral / 2 ** k, dtheta / 2 ** k) for k in range(MAX_HALVINGS + 1)] + [(0.0, 0.0)]
+        for n, (side_m, turn) in enumerate(tries):
+            frame = self.frame.moved(forward, side_m, turn)
             outward = 0.0
             for _ in range(MAX_PUSHES):
                 foothold = frame.foot(swing_side, self.half_width_m, outward)
-                gap = swept_gap_m(g, stance, old, foothold)
+                gap, share = swept_gap_where(g, stance, old, foothold)
                 if gap >= lim.min_gap_m:
-                    return frame, foothold
-                outward += lim.min_gap_m - gap + PUSH_MARGIN_M
+                    return frame, foothold, gap
+                # the last try (no sideways step, no turn): where the gap is least the sole moves outward by
+                # share x the push (a toe turning in early in the swing), so push that much more
+                last = n == len(tries) - 1
+                outward += (lim.min_gap_m - gap + PUSH_MARGIN_M) / (max(share, MIN_PUSH_SHARE) if last else 1.0)
                 if outward > lim.max_side_m + lim.min_gap_m:
                     break
-            lateral, dtheta = lateral / 2, dtheta / 2
-        frame = self.frame.moved(forward, 0.0, 0.0)  # last resort: no sideways step, no turn
-        return frame, frame.foot(swing_side, self.half_width_m)
+        frame = self.frame.moved(forward, 0.0, 0.0)  # last resort: no sideways step, no turn, no push
+        foothold = frame.foot(swing_side, self.half_width_m)
+        return frame, foothold, swept_gap_m(g, stance, old, foothold)
 
 
 def _same(a: FootPlacement, b: FootPlacement) -> bool:

@@ -49,6 +49,10 @@ class CommandSchedule:
         return STILL if k < 0 else self.commands[k].command
 
 
+GAP_TOLERANCE_M = 1e-4
+"""A planned step's soles may come this much closer than min_gap_m (float noise of the swept gap)."""
+
+
 def plan_footsteps(planner: FootstepPlanner, schedule: CommandSchedule, first_step_s: float, step_s: float,
                    max_steps: int) -> list[Footstep]:
     """Every step of a walk under ``schedule``: the first lasts ``first_step_s`` (its double support shifts
@@ -66,5 +70,9 @@ def plan_footsteps(planner: FootstepPlanner, schedule: CommandSchedule, first_st
                                f"(the stop comes at {schedule.end_s:g} s)")
         command = STILL if stopped else command
         side = leading_side(command) if side is None else OTHER[side]
-        steps.append(planner.next_step(command, side))
+        step = planner.next_step(command, side)
+        if step.gap_m < planner.limits.min_gap_m - GAP_TOLERANCE_M:  # the planner's last resort came too close
+            raise CommandError(f"step {len(steps) + 1} (at {t_s:.2f} s) would bring the soles {step.gap_m * 1e3:.1f} mm "
+                               f"apart, closer than the robot's [steer] min_gap_m ({planner.limits.min_gap_m * 1e3:g} mm)")
+        steps.append(step)
         t_s += first_step_s if len(steps) == 1 else step_s

@@ -130,7 +130,13 @@ def between(old: FootPlacement, new: FootPlacement, share: float) -> FootPlaceme
 
 def swept_gap_m(geometry: BodyGeometry, stance: FootPlacement, old: FootPlacement, new: FootPlacement) -> float:
     """The least gap between the stance sole and the swing sole along the swing's path."""
+    return swept_gap_where(geometry, stance, old, new)[0]
+
+
+def swept_gap_where(geometry: BodyGeometry, stance: FootPlacement, old: FootPlacement,
+                    new: FootPlacement) -> tuple[float, float]:
+    """(the least gap along the swing's path, the share of the way where it is least)."""
     box = sole_box(geometry, stance)
     edges = _edges(box)
-    return min(polygon_gap(box, sole_box(geometry, between(old, new, k / (SWEEP_SAMPLES - 1))), edges)
-               for k in range(SWEEP_SAMPLES))
+    return min((polygon_gap(box, sole_box(geometry, between(old, new, k / (SWEEP_SAMPLES - 1))), edges),
+                k / (SWEEP_SAMPLES - 1)) for k in range(SWEEP_SAMPLES))
