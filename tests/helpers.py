@@ -377,3 +377,18 @@ def cli(*argv: str) -> dict:
     return isolated(main, [str(a) for a in argv], capture=True)
 
 
+
+
+def knee_calibration(zero_tick: int, direction: int = 1) -> str:
+    """A calibration file's text for xl430-biped that moves only knee_pitch_left (servo 2)."""
+    return f"""[calibration]
+format = "gaitbot-calibration"
+version = 1
+robot = "xl430-biped"
+
+[joints.knee_pitch_left]
+id = 2
+model = "XL430-W250"
+zero_tick = {zero_tick}
+direction = {direction}
+"""

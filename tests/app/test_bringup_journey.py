@@ -29,19 +29,8 @@ from gaitbot.emulator.state import read_state
 from gaitbot.robot.calibration_file import calibration_path_for, load_robot_with_calibration, read_calibration
 from gaitbot.servos import common_baud_rates, max_servo_id, wire
 from gaitbot.stream.calibrate import CalibrationJoint, _judge
-from helpers import REPO_ROOT, config, run_cli
+from helpers import REPO_ROOT, config, knee_calibration, run_cli
 
-CALIBRATION = """[calibration]
-format = "gaitbot-calibration"
-version = 1
-robot = "xl430-biped"
-
-[joints.knee_pitch_left]
-id = 2
-model = "XL430-W250"
-zero_tick = {zero}
-direction = {direction}
-"""
 
 
 # --------------------------------------------------------------------------- the mock servos stand
@@ -50,7 +39,7 @@ direction = {direction}
 @pytest.mark.parametrize("zero, direction", [(2298, 1), (1798, 1), (2048, -1), (2300, -1)])
 def test_a_dry_run_with_an_off_centre_or_reversed_calibration_walks(zero, direction, tmp_path, capsys):
     path = tmp_path / "bot.calibration.toml"
-    path.write_text(CALIBRATION.format(zero=zero, direction=direction))
+    path.write_text(knee_calibration(zero, direction))
     code, out, err = run_cli(capsys, "walk", "--robot", "xl430-biped", "--calibration", path, "--dry-run",
                              "--steps", "0.03,0.03")
     assert code == 0 and "Walk completed" in out, out + err
@@ -58,7 +47,7 @@ def test_a_dry_run_with_an_off_centre_or_reversed_calibration_walks(zero, direct
 
 def test_the_dry_run_servos_start_at_the_stand_pose_in_the_calibrations_ticks(tmp_path):
     path = tmp_path / "bot.calibration.toml"
-    path.write_text(CALIBRATION.format(zero=2298, direction=-1))
+    path.write_text(knee_calibration(2298, -1))
     robot = load_robot_with_calibration("xl430-biped", path)
     with make_robot_bus(robot, dry_run=True) as bus:
         present = bus.read_present_ticks(robot.ids)

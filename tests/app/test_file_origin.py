@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers import REPO_ROOT, run_cli
+from helpers import REPO_ROOT, knee_calibration, run_cli
 
 STAIRS = REPO_ROOT / "config" / "terrain" / "stairs.toml"
 KERB = REPO_ROOT / "config" / "terrain" / "kerb.toml"
@@ -156,22 +156,11 @@ def test_a_bad_npz_origin_is_one_line(capsys, files, tmp_path):
     assert "origin_treads" in err
 
 
-CALIBRATION = """[calibration]
-format = "gaitbot-calibration"
-version = 1
-robot = "xl430-biped"
-
-[joints.knee_pitch_left]
-id = 2
-model = "XL430-W250"
-zero_tick = {tick}
-direction = -1
-"""
 
 
 def test_a_recording_remembers_its_calibration(capsys, tmp_path):
     calibration = tmp_path / "knee.calibration.toml"
-    calibration.write_text(CALIBRATION.format(tick=2600))
+    calibration.write_text(knee_calibration(2600, -1))
     run = tmp_path / "run.jsonl"
     code, _, err = run_cli(capsys, "walk", "--dry-run", "--distance", "0.2", "--calibration", calibration,
                            "--record", run)
@@ -185,7 +174,7 @@ def test_a_recording_remembers_its_calibration(capsys, tmp_path):
     code, _, _ = run_cli(capsys, "check", run, "--calibration", calibration)  # the same one: fine
     assert code == 0
     other = tmp_path / "other.calibration.toml"
-    other.write_text(CALIBRATION.format(tick=2610))
+    other.write_text(knee_calibration(2610, -1))
     err = one_line_exit_2(run_cli(capsys, "check", run, "--calibration", other))
     assert "sent with another calibration" in err and "knee_pitch_left" in err
     # the same recording without the field (as written before headers kept it) fails as it did
