@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+
+import numpy as np
 from pathlib import Path
 
 DEFAULT_FOXGLOVE = "127.0.0.1:8765"  # gaitbot.view.live's default: loopback only
@@ -57,11 +59,30 @@ def felt_now(health=None, feedback=None, sim_robot=None):
 
     reading = getattr(feedback, "reading", None)
     tilt = (feedback.estimate.roll_deg, feedback.estimate.pitch_deg) if reading is not None else None
-    com = pelvis = None
+    com = pelvis = contacts = None
     if sim_robot is not None and hasattr(sim_robot, "torso_body"):
         data, body = sim_robot.data, sim_robot.torso_body
         com, pelvis = data.subtree_com[body].copy(), (data.xpos[body].copy(), data.xmat[body].reshape(3, 3).copy())
-    return FeltSample(reading, tilt, getattr(health, "last_read_back", None), com, pelvis)
+        contacts = _floor_contacts(sim_robot)
+    return FeltSample(reading, tilt, getattr(health, "last_read_back", None), com, pelvis, contacts)
+
+
+def _floor_contacts(sim_robot):
+    """The simulated floor's contacts now: points (K, 3) and normal forces (K,) (MuJoCo's mj_contactForce), or
+    None where the model has no floor geom the robot knows of."""
+    floor = getattr(sim_robot, "floor_geom", None)
+    if floor is None:
+        return None
+    mujoco, model, data = sim_robot.mujoco, sim_robot.model, sim_robot.data
+    force = np.zeros(6)
+    points, normals = [], []
+    for i in range(data.ncon):
+        contact = data.contact[i]
+        if floor in (contact.geom1, contact.geom2):
+            mujoco.mj_contactForce(model, data, i, force)
+            points.append(contact.pos.copy())
+            normals.append(force[0])
+    return (np.array(points).reshape(-1, 3), np.array(normals))
 
 
 class WalkView:

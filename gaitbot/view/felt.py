@@ -9,6 +9,7 @@ frame, in turn: gaitbot.stream.readback), and in a simulation the measured centr
 * the IMU in SI units (rad/s, m/s^2 with gravity in it, as sensor_msgs/Imu wants), its orientation from the
   walk's own roll and pitch, yaw 0 (the walk estimates no yaw; its variance says "unknown"), and each
   diagonal variance from the config's ``[imu]`` noise figures;
+* a simulation's measured ZMP: the centre of pressure of its floor contacts;
 * the read-back angles of every joint, each the latest its servo gave (a joint is read every
   ``len(joints)`` frames), through the calibration: from the frame where every servo has answered once.
 """
@@ -37,13 +38,27 @@ class FeltSample:
     """The loop's hand-over (no computation): ``imu`` a gaitbot.servos.opencr.ImuReading in the torso's axes
     (None: no reading this frame), ``tilt_deg`` the walk's (roll, pitch) estimate after it, ``read_back`` the
     session's latest answered gaitbot.bus.base.ReadBack (servo id, present ticks), ``com_m`` (3,) and
-    ``pelvis`` (position (3,), rotation (3, 3)) measured by a simulation, world frame."""
+    ``pelvis`` (position (3,), rotation (3, 3)) measured by a simulation, world frame, and its floor contacts
+    (points (K, 3) m, normal forces (K,) N)."""
 
     imu: object | None = None
     tilt_deg: tuple[float, float] | None = None
     read_back: object | None = None
     com_m: np.ndarray | None = None
     pelvis: tuple[np.ndarray, np.ndarray] | None = None
+    contacts: tuple[np.ndarray, np.ndarray] | None = None
+
+
+def centre_of_pressure(contacts) -> np.ndarray | None:
+    """(x, y) of the floor's reaction (m): its contact points weighted by their normal forces; on flat ground the
+    ZMP (Vukobratovic and Borovac, "Zero-moment point: thirty five years of its life", 2004). None in the air."""
+    if contacts is None:
+        return None
+    points, forces = contacts
+    total = float(np.sum(forces))
+    if not total > 0.0:
+        return None
+    return (np.asarray(forces) @ np.asarray(points)[:, :2]) / total
 
 
 class Felt:
@@ -93,4 +108,7 @@ class Felt:
             extra["measured_com_m"] = felt.com_m
         if felt.pelvis is not None:
             extra["measured_pelvis"] = felt.pelvis
+        zmp = centre_of_pressure(felt.contacts)
+        if zmp is not None:
+            extra["measured_zmp_m"] = zmp
         return dataclasses.replace(frame, **extra)

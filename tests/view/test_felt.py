@@ -12,7 +12,7 @@ from gaitbot.robot.calibration import angles_to_ticks  # noqa: E402
 from gaitbot.robot.description.tree import rpy_matrix  # noqa: E402
 from gaitbot.robot.description.urdf_writer import urdf_text  # noqa: E402
 from gaitbot.servos.opencr import ImuReading  # noqa: E402
-from gaitbot.view.felt import Felt, FeltSample  # noqa: E402
+from gaitbot.view.felt import Felt, FeltSample, centre_of_pressure  # noqa: E402
 from gaitbot.view.telemetry import FrameTelemetry  # noqa: E402
 from helpers import config, run_cli  # noqa: E402
 from test_mcap_log import read_back  # noqa: E402
@@ -52,6 +52,12 @@ def test_read_back_once_every_servo_answered_and_each_its_latest():
     assert all(r is None for r in results[:-1])  # a joint never read is not guessed
     half_tick = 0.5 / np.array([j.model.ticks_per_rad for j in cfg.joints])
     assert np.all(np.abs(results[-1] - angles) <= half_tick + 1e-12)
+
+
+def test_centre_of_pressure_weighs_the_contacts_by_their_normal_force():
+    points = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, 0.2, 0.0]])
+    assert centre_of_pressure((points, np.array([1.0, 1.0, 2.0]))) == pytest.approx((0.075, 0.1))
+    assert centre_of_pressure((points[:0], np.zeros(0))) is None  # in the air: no ZMP
 
 
 def test_a_frame_without_sensors_is_left_as_it_is():
@@ -98,6 +104,12 @@ def test_simulated_walk_logs_the_imu_every_frame_and_it_feels_gravity(tmp_path, 
     assert np.allclose((com.x, com.y, com.z), (measured.x, measured.y, measured.z), atol=2e-3)
     travelled = float(out.split("travelled ")[1].split(" m")[0])
     assert log["/com_measured"][-1][-1].point.x - measured.x == pytest.approx(travelled, abs=0.02)
+    # the measured ZMP (the floor contacts' centre of pressure) averages to the measured CoM's ground point: the
+    # CoM's horizontal acceleration, which sets them apart (p = c - z/g c''), averages ~0 from rest to rest
+    zmp = np.array([(m.point.x, m.point.y) for *_, m in log["/zmp_measured"]])
+    com_xy = np.array([(m.point.x, m.point.y) for *_, m in log["/com_measured"]])
+    assert len(zmp) == walk_frames
+    assert np.allclose(zmp.mean(axis=0), com_xy.mean(axis=0), atol=0.01)
 
 
 def test_a_robot_without_an_imu_has_no_imu_channel(tmp_path, capsys):
