@@ -3,7 +3,8 @@
 The 60 Hz loop only gathers references and a few copies into a :class:`FeltSample`: the IMU reading the walk's
 feedback took this frame (gaitbot.feel: body rates in deg/s and specific force in g, torso axes) with the
 roll and pitch its complementary filter made of it, the servo read-back the session got last (one servo a
-frame, in turn: gaitbot.stream.readback), and in a simulation the measured centre of mass and pelvis pose.
+frame, in turn: gaitbot.stream.readback), and in a simulation the measured centre of mass, pelvis pose and
+floor contacts.
 :class:`Felt`, called on the worker thread (gaitbot.view.publisher), makes the ROS 2 quantities of them:
 
 * the IMU in SI units (rad/s, m/s^2 with gravity in it, as sensor_msgs/Imu wants), its orientation from the
