@@ -9,7 +9,9 @@ worker's own cost per frame (every channel encoded to CDR and written). Sinks: n
 Foxglove server with no client, and with a loopback client subscribed to every channel (its own thread,
 as Foxglove would be). "worker: drive record": a drive's frame made on the worker (gaitbot.view.
 drive_telemetry: goals from the ticks, CoM, ZMP, soles and support over three frames) and encoded.
-Machine-dependent figures.
+"+ sensors" rows: each frame also carries what the robot felt (an IMU reading with the walk's tilt
+estimate, and one servo's read-back: gaitbot.app.view_options.felt_now in the loop, gaitbot.view.felt on
+the worker). Machine-dependent figures.
 """
 
 from __future__ import annotations
@@ -28,6 +30,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from gaitbot.app.options import load_robot  # noqa: E402
+from gaitbot.app.view_options import felt_now  # noqa: E402
+from gaitbot.bus.base import ReadBack, ReadBackOutcome  # noqa: E402
+from gaitbot.feel.feedback import Feedback  # noqa: E402
+from gaitbot.robot.calibration import standing_ticks  # noqa: E402
+from gaitbot.servos.opencr import ImuReading  # noqa: E402
 from gaitbot.gait.joints import LEG_JOINTS  # noqa: E402
 from gaitbot.gait.trajectory import Trajectory  # noqa: E402
 from gaitbot.robot.balanced_walk import plan_balanced  # noqa: E402
@@ -76,18 +83,43 @@ def subscriber(port: int, stop: threading.Event) -> threading.Thread:
     return thread
 
 
-def measure(frames: PlannedFrames, config, sinks, threaded: bool = True, repeats: int = 3) -> np.ndarray:
+class Sensors:
+    """A walk's sensors as the loop finds them each frame: the feedback after an IMU reading (the OP3 standing,
+    a little noise), and the health monitor's latest read-back (one servo a frame, in turn)."""
+
+    def __init__(self, config) -> None:
+        self.feedback = Feedback(config, "full", None, 1 / 60, time.perf_counter)
+        self.rng = np.random.default_rng(1)
+        self.answers = [ReadBack(i, ReadBackOutcome.ANSWERED, int(t)) for i, t in zip(config.ids, standing_ticks(config))]
+        self.last_read_back = None
+
+    def felt(self, k: int):
+        reading = ImuReading(self.rng.normal(0, 0.5, 3), np.array([0.0, 0.0, 1.0]) + self.rng.normal(0, 0.02, 3),
+                             np.zeros(3))
+        self.feedback.reading = reading
+        self.feedback.estimate.update(reading)
+        self.last_read_back = self.answers[k % len(self.answers)]
+        start = time.perf_counter()
+        felt = felt_now(self, self.feedback)  # what the loop does (this object stands for the health monitor)
+        return felt, time.perf_counter() - start
+
+
+def measure(frames: PlannedFrames, config, sinks, threaded: bool = True, repeats: int = 3,
+            sensors: bool = False) -> np.ndarray:
     """Microseconds per observer call: the call the loop makes (threaded: what walk and drive use), or the
-    encoding and writing itself (not threaded: the worker thread's own cost per frame)."""
+    encoding and writing itself (not threaded: the worker thread's own cost per frame). ``sensors``: each
+    frame carries what the robot felt, gathered as the loop gathers it (that gathering timed too)."""
     publisher = TelemetryPublisher(config, sinks)
     if threaded:
         publisher = BackgroundPublisher(publisher)
     health = ServoHealth(0, "servo health over 100 reads", 31.0, 12.0, 20.0)
+    robot = Sensors(config) if sensors else None
     cost = []
     for _ in range(repeats):
         for k in range(len(frames)):
-            start = time.perf_counter()
-            publisher.on_frame(frames.frame(k, health=health, command=(0.1, 0.0, 0.0)))
+            felt, gathering_s = robot.felt(k) if robot is not None else (None, 0.0)
+            start = time.perf_counter() - gathering_s
+            publisher.on_frame(frames.frame(k, health=health, command=(0.1, 0.0, 0.0), felt=felt))
             cost.append(time.perf_counter() - start)
             time.sleep(max(0.0, 1 / 60 - (time.perf_counter() - start)))  # a 60 Hz loop's pace
     publisher.close()
@@ -107,6 +139,8 @@ def main() -> None:
                 ("loop: --foxglove, no client", [FoxgloveSink("127.0.0.1", 0)], True)]
         for name, sinks, threaded in rows:
             _row(name, measure(frames, config, sinks, threaded))
+        _row("worker: encode only + sensors", measure(frames, config, [NullSink()], False, sensors=True))
+        _row("loop: --mcap + sensors", measure(frames, config, [McapSink(Path(tmp) / "s.mcap")], True, sensors=True))
         _row("worker: drive record + encode", measure_drive(config, plan.walk))
         live = FoxgloveSink("127.0.0.1", 0)
         stop = threading.Event()

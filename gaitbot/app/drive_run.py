@@ -169,7 +169,7 @@ def _drive(args, config, source, commands_out, mode: str, view=None) -> int:
             result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,
                                   max_accel_ticks_per_s2=acceleration, period_s=frames.period_s, clock=clock,
                                   torque_off_on_exit=config.bus.torque_off_on_exit,
-                                  on_frame=_on_frame(view, frames, health, clock), handle_sigterm=False,
+                                  on_frame=_on_frame(view, frames, health, clock, sim, feedback), handle_sigterm=False,
                                   setup_writes=gain_writes(config), health=health, feedback=feedback)
     finally:
         if recorder is not None:
@@ -179,10 +179,12 @@ def _drive(args, config, source, commands_out, mode: str, view=None) -> int:
     return _report(args, config, frames, result, signals.first, sim, feedback)
 
 
-def _on_frame(view, frames: DriveFrames, health: HealthMonitor, clock):
-    """The status line, and the view's telemetry when --mcap or --foxglove is on."""
+def _on_frame(view, frames: DriveFrames, health: HealthMonitor, clock, sim=None, feedback=None):
+    """The status line, and the view's telemetry when --mcap or --foxglove is on (the IMU's readings when the
+    drive's feedback reads one)."""
     status = _status_line(frames, health)
-    return status if view is None else view.attach(frames, health, not isinstance(clock, VirtualClock), status)
+    return status if view is None else view.attach(frames, health, not isinstance(clock, VirtualClock), status,
+                                                   feedback=feedback, sim_robot=sim.robot if sim is not None else None)
 
 
 def _from_zero(clock):

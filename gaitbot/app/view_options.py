@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+
+import numpy as np
 from pathlib import Path
 
 DEFAULT_FOXGLOVE = "127.0.0.1:8765"  # gaitbot.view.live's default: loopback only
@@ -48,6 +50,41 @@ def add_view_options(p) -> None:
                    "from the network) and take its Teleop panel's Twists on /cmd_vel (drive)")
 
 
+def felt_now(health=None, feedback=None, sim_robot=None):
+    """What the robot's sensors gave this frame, gathered for the view's worker (gaitbot.view.felt.FeltSample):
+    references and a few copies, no computation. ``health``: the session's HealthMonitor (its latest servo
+    read-back); ``feedback``: the walk's gaitbot.feel.Feedback (its IMU reading and tilt estimate);
+    ``sim_robot``: a simulation's robot (its measured centre of mass and pelvis pose), or None each."""
+    from gaitbot.view.felt import FeltSample
+
+    reading = getattr(feedback, "reading", None)
+    tilt = (feedback.estimate.roll_deg, feedback.estimate.pitch_deg) if reading is not None else None
+    com = pelvis = contacts = None
+    if sim_robot is not None and hasattr(sim_robot, "torso_body"):
+        data, body = sim_robot.data, sim_robot.torso_body
+        com, pelvis = data.subtree_com[body].copy(), (data.xpos[body].copy(), data.xmat[body].reshape(3, 3).copy())
+        contacts = _floor_contacts(sim_robot)
+    return FeltSample(reading, tilt, getattr(health, "last_read_back", None), com, pelvis, contacts)
+
+
+def _floor_contacts(sim_robot):
+    """The simulated floor's contacts now: points (K, 3) and normal forces (K,) (MuJoCo's mj_contactForce), or
+    None where the model has no floor geom the robot knows of."""
+    floor = getattr(sim_robot, "floor_geom", None)
+    if floor is None:
+        return None
+    mujoco, model, data = sim_robot.mujoco, sim_robot.model, sim_robot.data
+    force = np.zeros(6)
+    points, normals = [], []
+    for i in range(data.ncon):
+        contact = data.contact[i]
+        if floor in (contact.geom1, contact.geom2):
+            mujoco.mj_contactForce(model, data, i, force)
+            points.append(contact.pos.copy())
+            normals.append(force[0])
+    return (np.array(points).reshape(-1, 3), np.array(normals))
+
+
 class WalkView:
     """The observer of one walk (gaitbot.view.publisher.TelemetryPublisher over the asked-for sinks) and the
     planned frames it reads from; ``teleop`` is the Foxglove command source when --foxglove is on."""
@@ -55,12 +92,15 @@ class WalkView:
     def __init__(self, publisher, frames, teleop=None) -> None:
         self.publisher, self.frames, self.teleop = publisher, frames, teleop
         self.health = None  # a HealthMonitor, summarised in each frame when set
+        self.feedback = None  # the walk's gaitbot.feel.Feedback when it reads an IMU: /imu
+        self.sim_robot = None  # --sim: the simulated robot, for the measured CoM and pelvis pose
 
     def on_frame(self, k: int, **extra) -> None:
         """Frame k of the planned walk (the session's walk-frame index), with what the session adds."""
         from gaitbot.view.telemetry import health_of
 
-        self.publisher.on_frame(self.frames.frame(k, health=health_of(self.health), **extra))
+        felt = felt_now(self.health, self.feedback, self.sim_robot)
+        self.publisher.on_frame(self.frames.frame(k, health=health_of(self.health), felt=felt, **extra))
 
     def chain(self, on_frame):
         """A session ``on_frame(k, stats)`` callback that also feeds the view."""
@@ -102,9 +142,11 @@ def _open_sinks(mcap, foxglove):
     return sinks, teleop
 
 
-def open_view(args, config, goals, planned=None, health=None, realtime: bool = True) -> WalkView | None:
+def open_view(args, config, goals, planned=None, health=None, realtime: bool = True, feedback=None,
+              sim_robot=None) -> WalkView | None:
     """The view of ``args.mcap`` / ``args.foxglove`` for this walk, or None when neither was asked for;
-    ``realtime``: the walk runs on a real clock (a full telemetry queue then drops a frame, never waits)."""
+    ``realtime``: the walk runs on a real clock (a full telemetry queue then drops a frame, never waits);
+    ``feedback`` and ``sim_robot`` as felt_now's."""
     mcap, foxglove = getattr(args, "mcap", None), getattr(args, "foxglove", None)
     if mcap is None and foxglove is None:
         return None
@@ -114,7 +156,7 @@ def open_view(args, config, goals, planned=None, health=None, realtime: bool = T
 
     publisher = BackgroundPublisher(TelemetryPublisher(config, sinks), lossless=not realtime)
     view = WalkView(publisher, PlannedFrames(config, goals, planned), teleop)
-    view.health = health
+    view.health, view.feedback, view.sim_robot = health, feedback, sim_robot
     return view
 
 
@@ -139,9 +181,9 @@ class DriveView:
         self.config, self.sinks, self.teleop = config, sinks, teleop
         self.publisher = None
 
-    def attach(self, frames, health, realtime: bool, on_frame=None):
+    def attach(self, frames, health, realtime: bool, on_frame=None, feedback=None, sim_robot=None):
         """A session ``on_frame(k, stats)`` callback feeding the view from ``frames`` (gaitbot.drive.frames),
-        then calling ``on_frame``; ``realtime`` as open_view's."""
+        then calling ``on_frame``; ``realtime`` as open_view's; ``feedback``, ``sim_robot`` as felt_now's."""
         import math
 
         from gaitbot.view.drive_telemetry import DriveSample, DriveTelemetry
@@ -156,7 +198,8 @@ class DriveView:
             ticks, body, root, yaw = frames.body_pose()
             c = frames.command
             publisher.on_frame(DriveSample(frames.k * frames.period_s, ticks.copy(), body.copy(), root, yaw,
-                                           (c.vx_m_s, c.vy_m_s, math.radians(c.wz_deg_s)), health_of(health)))
+                                           (c.vx_m_s, c.vy_m_s, math.radians(c.wz_deg_s)), health_of(health),
+                                           felt_now(health, feedback, sim_robot)))
             if on_frame is not None:
                 on_frame(k, stats)
         return both

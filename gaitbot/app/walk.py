@@ -135,7 +135,8 @@ def run(args) -> int:
                           health=health, feedback=feedback)
     view = None
     try:
-        view = open_view(args, config, walk.goals, walk.planned, health, not isinstance(clock, VirtualClock))
+        view = open_view(args, config, walk.goals, walk.planned, health, not isinstance(clock, VirtualClock),
+                         feedback, sim.robot if sim is not None else None)
         with progress("simulating" if sim is not None else "walking", total=len(frames), unit="frame") as bar:
             status = _status(bar, walk.heel_strikes, walk.rate_hz, health)
             result = session.run(frames, view.chain(status) if view else status)

@@ -83,6 +83,7 @@ class Feedback:
         self.previous: np.ndarray | None = None
         self.correction_rad = np.zeros(len(joints))
         self.fresh = False
+        self.reading = None  # the last sense()'s reading (None: missed), for whoever watches the walk
 
     @property
     def active(self) -> bool:
@@ -94,6 +95,7 @@ class Feedback:
             return
         reading = self.reader.read(deadline_s)
         self.fresh = reading is not None
+        self.reading = reading
         if reading is not None:
             self.estimate.update(reading)
 

@@ -58,6 +58,7 @@ class HealthMonitor:
         self.clock = clock or (lambda: 0.0)
         self.status = ""
         self.readings = 0
+        self.last_read_back: ReadBack | None = None  # the latest answer (its present ticks: the live view's)
         self.hottest: Extreme | None = None
         self.lowest_voltage: Extreme | None = None
         self.peak_load: Extreme | None = None
@@ -73,6 +74,7 @@ class HealthMonitor:
 
     def observe_read_back(self, answer: ReadBack) -> None:
         """An answered per-frame read-back (gaitbot.stream.readback) whose data is this servo's health block."""
+        self.last_read_back = answer
         block = self.blocks.get(answer.servo_id)
         if block is not None and answer.data is not None and len(answer.data) >= block.length:
             self.observe(decode_health(block, answer.servo_id, answer.data[:block.length]))

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+from gaitbot.robot.description.frames import TORSO_LINK
 from gaitbot.view.link_frames import WORLD_FRAME, LinkTransforms, rotation_xyzw
 from gaitbot.view.telemetry import FrameTelemetry
 
@@ -22,6 +23,7 @@ CHANNELS = {
     "/zmp": "geometry_msgs/msg/PointStamped",
     "/com_measured": "geometry_msgs/msg/PointStamped",
     "/zmp_measured": "geometry_msgs/msg/PointStamped",
+    "/pose_measured": "geometry_msgs/msg/PoseStamped",
     "/support_polygon": "geometry_msgs/msg/PolygonStamped",
     "/footprints": "geometry_msgs/msg/PoseArray",
     "/diagnostics": "diagnostic_msgs/msg/DiagnosticArray",
@@ -34,8 +36,16 @@ STATIC_CHANNELS = ("/tf_static", "/robot_description")
 """Written once at the start of a log, and again every few seconds to a live server (a client that connects
 later gets them too): the fixed frames, and the URDF the 3D panel draws (``gaitbot robot export --urdf``)."""
 
-IMU_FRAME = "imu_link"
-_UNKNOWN_COVARIANCE = [-1.0] + [0.0] * 8  # sensor_msgs/Imu: element 0 = -1 means "no estimate"
+IMU_FRAME = TORSO_LINK  # the exported URDF's torso frame (on base_link): the readings are in the torso's axes
+_NO_ESTIMATE = [-1.0] + [0.0] * 8  # sensor_msgs/Imu: element 0 = -1 means "no estimate"
+
+
+def _covariance(variances) -> list[float]:
+    """A 3 x 3 covariance, row major, of diagonal ``variances`` (all zeros, sensor_msgs' "unknown", without)."""
+    out = [0.0] * 9
+    for i, v in enumerate(variances or ()):
+        out[4 * i] = float(v)
+    return out
 
 
 def header(stamp_ns: int, frame_id: str = "") -> dict:
@@ -69,9 +79,11 @@ def _imu(stamp_ns: int, imu) -> dict:
     orientation = imu.orientation_xyzw
     return {"header": header(stamp_ns, IMU_FRAME),
             "orientation": _quaternion(orientation if orientation is not None else (0.0, 0.0, 0.0, 1.0)),
-            "orientation_covariance": [0.0] * 9 if orientation is not None else _UNKNOWN_COVARIANCE,
-            "angular_velocity": _xyz(imu.angular_velocity_rad_s), "angular_velocity_covariance": [0.0] * 9,
-            "linear_acceleration": _xyz(imu.linear_acceleration_m_s2), "linear_acceleration_covariance": [0.0] * 9}
+            "orientation_covariance": _covariance(imu.orientation_variance) if orientation is not None else _NO_ESTIMATE,
+            "angular_velocity": _xyz(imu.angular_velocity_rad_s),
+            "angular_velocity_covariance": _covariance(imu.angular_velocity_variance),
+            "linear_acceleration": _xyz(imu.linear_acceleration_m_s2),
+            "linear_acceleration_covariance": _covariance(imu.linear_acceleration_variance)}
 
 
 def _transform(stamp_ns: int, t) -> dict:
@@ -101,6 +113,10 @@ def frame_messages(frame: FrameTelemetry, stamp_ns: int, links: LinkTransforms) 
                          ("/zmp_measured", frame.measured_zmp_m)):
         if point is not None:
             out.append((topic, {"header": header(stamp_ns, WORLD_FRAME), "point": _xyz(point)}))
+    if frame.measured_pelvis is not None:
+        position, rotation = frame.measured_pelvis
+        out.append(("/pose_measured", {"header": header(stamp_ns, WORLD_FRAME), "pose": {
+            "position": _xyz(position), "orientation": _quaternion(rotation_xyzw(rotation))}}))
     if frame.support_m is not None:
         out.append(("/support_polygon", {"header": header(stamp_ns, WORLD_FRAME), "polygon": {
             "points": [{"x": float(x), "y": float(y), "z": 0.0} for x, y in frame.support_m]}}))
@@ -111,6 +127,3 @@ def frame_messages(frame: FrameTelemetry, stamp_ns: int, links: LinkTransforms) 
     if frame.health is not None:
         out.append(("/diagnostics", _diagnostics(stamp_ns, frame.health)))
     return out
-
-
-

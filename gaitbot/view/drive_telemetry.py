@@ -42,6 +42,7 @@ class DriveSample:
     yaw_rad: float
     command: tuple[float, float, float]
     health: ServoHealth | None = None
+    felt: object | None = None  # gaitbot.view.felt.FeltSample: the sensors' readings, made telemetry on the worker
 
 
 class DriveTelemetry:
@@ -73,7 +74,7 @@ class DriveTelemetry:
         return FrameTelemetry(t_s=sample.t_s, joints=self.joints, goals_rad=ticks_to_angles(self.config, sample.ticks),
                               root_m=sample.root_m, root_rpy_rad=rpy[-1], com_m=trace.com_m[-1], zmp_m=trace.zmp_m[-1],
                               soles_m=soles, support_m=trace.support[-1], health=sample.health,
-                              command=sample.command)
+                              command=sample.command, felt=sample.felt)
 
     def on_frame(self, sample: DriveSample) -> None:
         self.publisher.on_frame(self.frame(sample))

@@ -18,6 +18,7 @@ import time
 from gaitbot.robot.config import RobotConfig
 from gaitbot.robot.description.urdf_writer import urdf_text
 from gaitbot.view.channels import CHANNELS, frame_messages, static_messages
+from gaitbot.view.felt import Felt
 from gaitbot.view.link_frames import LinkTransforms
 from gaitbot.view.ros2_messages import encoder
 from gaitbot.view.telemetry import FrameTelemetry
@@ -36,6 +37,7 @@ class TelemetryPublisher:
     def __init__(self, config: RobotConfig, sinks, start_ns: int | None = None) -> None:
         self.links = LinkTransforms(config)
         self.urdf = urdf_text(config)
+        self.felt = Felt(config)  # the sensors' raw readings, made telemetry here (on the worker)
         self._static_due_s = 0.0
         self.sinks = list(sinks)
         self.start_ns = time.time_ns() if start_ns is None else int(start_ns)
@@ -46,6 +48,7 @@ class TelemetryPublisher:
     def on_frame(self, frame: FrameTelemetry) -> None:
         if not self.sinks:
             return
+        frame = self.felt.resolve(frame)
         stamp_ns = self.start_ns + round(frame.t_s * 1e9)
         messages = frame_messages(frame, stamp_ns, self.links)
         if self.frames == 0 or frame.t_s >= self._static_due_s:

@@ -39,6 +39,7 @@ DEFINITIONS = {
                            "float64[9] angular_velocity_covariance\ngeometry_msgs/Vector3 linear_acceleration\n"
                            "float64[9] linear_acceleration_covariance",
     "geometry_msgs/msg/PointStamped": "std_msgs/Header header\ngeometry_msgs/Point point",
+    "geometry_msgs/msg/PoseStamped": "std_msgs/Header header\ngeometry_msgs/Pose pose",
     "geometry_msgs/msg/PolygonStamped": "std_msgs/Header header\ngeometry_msgs/Polygon polygon",
     "geometry_msgs/msg/PoseArray": "std_msgs/Header header\ngeometry_msgs/Pose[] poses",
     "diagnostic_msgs/msg/DiagnosticArray": "std_msgs/Header header\ndiagnostic_msgs/DiagnosticStatus[] status",

@@ -21,11 +21,15 @@ NEEDS_VIEW_EXTRA = "needs pip install 'gaitbot[view]'"
 @dataclass(frozen=True)
 class ImuSample:
     """An IMU reading in the IMU's (the torso's) frame: angular velocity (rad/s) and linear acceleration (m/s^2,
-    gravity included, as sensor_msgs/Imu); orientation (x, y, z, w) where the IMU estimates it, else None."""
+    gravity included, as sensor_msgs/Imu); orientation (x, y, z, w) where the IMU estimates it, else None;
+    each one's variances about x, y, z (rad^2, (rad/s)^2, (m/s^2)^2: the covariances' diagonals) where known."""
 
     angular_velocity_rad_s: tuple[float, float, float]
     linear_acceleration_m_s2: tuple[float, float, float]
     orientation_xyzw: tuple[float, float, float, float] | None = None
+    orientation_variance: tuple[float, float, float] | None = None
+    angular_velocity_variance: tuple[float, float, float] | None = None
+    linear_acceleration_variance: tuple[float, float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -48,9 +52,12 @@ class FrameTelemetry:
     read_back_rad: angles read back from the servos where the session has them (None otherwise; a joint not
     read this frame is NaN). root_m and root_rpy_rad: the pelvis (base_link) pose, roll, pitch, yaw.
     com_m (3,) and zmp_m (2,): the planned centre of mass and ZMP; measured_com_m / measured_zmp_m where a
-    simulation or a sensor gives them. soles_m: each foot's sole box, side -> (centre (3,), rotation (3, 3))
+    simulation or a sensor gives them; measured_pelvis: the pelvis's (position (3,), rotation (3, 3)) a
+    simulation measured. soles_m: each foot's sole box, side -> (centre (3,), rotation (3, 3))
     of its underside; support_m: the support polygon (K, 2), counter-clockwise, on the floor.
-    command: (vx m/s, vy m/s, wz rad/s) in force (None for a walk without one)."""
+    command: (vx m/s, vy m/s, wz rad/s) in force (None for a walk without one). felt: what the robot's
+    sensors gave this frame, as the loop handed it over (gaitbot.view.felt.FeltSample); the worker turns it
+    into ``imu``, ``read_back_rad`` and the measured fields before the channels are made."""
 
     t_s: float
     joints: tuple[str, ...]
@@ -62,11 +69,13 @@ class FrameTelemetry:
     zmp_m: np.ndarray | None = None
     measured_com_m: np.ndarray | None = None
     measured_zmp_m: np.ndarray | None = None
+    measured_pelvis: tuple[np.ndarray, np.ndarray] | None = None
     soles_m: dict | None = None
     support_m: np.ndarray | None = None
     imu: ImuSample | None = None
     health: ServoHealth | None = None
     command: tuple[float, float, float] | None = None
+    felt: object | None = None
 
 
 class Telemetry(Protocol):

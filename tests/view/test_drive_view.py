@@ -50,8 +50,8 @@ def test_a_drive_mcap_holds_every_channel_at_the_frame_rate(tmp_path, capsys):
     report = json.loads(out)
     log = read_back(mcap)
     expected = {"/joint_goals", "/tf", "/walk_command", "/com", "/zmp", "/support_polygon", "/footprints",
-                "/diagnostics"}  # a dry run has no read-back and no IMU
-    assert set(log) == expected | {"/tf_static", "/robot_description"}  # those once, at the start
+                "/diagnostics"}  # a dry run has no IMU; its read-back (/joint_states) starts once every servo answered
+    assert set(log) == expected | {"/joint_states", "/tf_static", "/robot_description"}  # the static ones once
     counts = {len(log[topic]) for topic in expected}
     assert counts == {report["frames"] - 1}  # the first frame is the start ramp's target, not streamed
     for topic in expected:

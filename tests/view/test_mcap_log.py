@@ -43,7 +43,7 @@ def random_frames(n: int, rng) -> list[FrameTelemetry]:
             root_rpy_rad=rng.uniform(-0.3, 0.3, 3), read_back_rad=read, com_m=rng.uniform(-1, 1, 3),
             zmp_m=rng.uniform(-1, 1, 2), measured_com_m=rng.uniform(-1, 1, 3), measured_zmp_m=rng.uniform(-1, 1, 2),
             soles_m={"left": (rng.uniform(-1, 1, 3), np.eye(3)), "right": (rng.uniform(-1, 1, 3), np.eye(3))},
-            support_m=rng.uniform(-1, 1, (4, 2)),
+            support_m=rng.uniform(-1, 1, (4, 2)), measured_pelvis=(rng.uniform(-1, 1, 3), np.eye(3)),
             imu=ImuSample(tuple(rng.uniform(-1, 1, 3)), tuple(rng.uniform(-9, 9, 3))),
             health=ServoHealth(1, "servo 7 at 61 °C", 61.0, 11.9, 40.0), command=tuple(rng.uniform(-1, 1, 3))))
     return frames
@@ -77,6 +77,9 @@ def test_every_channel_every_frame_decodes_to_what_was_sent(tmp_path):
         assert imu.orientation_covariance[0] == -1.0  # no orientation estimate, as sensor_msgs/Imu says
         assert np.allclose([(p.x, p.y) for p in polygon.polygon.points], frame.support_m, atol=1e-6)  # float32
         assert diag.status[0].level == 1 and diag.status[0].message == "servo 7 at 61 °C"
+    for frame, (_, _, _, pose) in zip(frames, log["/pose_measured"]):
+        p, q = pose.pose.position, pose.pose.orientation
+        assert (p.x, p.y, p.z) == tuple(frame.measured_pelvis[0]) and (q.x, q.y, q.z, q.w) == (0.0, 0.0, 0.0, 1.0)
 
 
 def test_walk_mcap_holds_every_channel_at_the_frame_rate_and_the_goals_the_servos_got(tmp_path, capsys):
@@ -87,7 +90,8 @@ def test_walk_mcap_holds_every_channel_at_the_frame_rate_and_the_goals_the_servo
     walk_frames = int(out.split("Sent ")[1].split()[0])
     log = read_back(mcap)
     expected = {"/joint_goals", "/tf", "/com", "/zmp", "/support_polygon", "/footprints", "/diagnostics"}
-    assert set(log) == expected | set(STATIC_CHANNELS)  # a dry run has no read-back, IMU or command
+    # a dry run has no IMU (the mock bus has no OpenCR) and no command; its mock servos are read back
+    assert set(log) == expected | {"/joint_states"} | set(STATIC_CHANNELS)
     for topic in expected:
         times = np.array([t for t, *_ in log[topic]])
         assert len(times) == walk_frames, topic
@@ -98,6 +102,17 @@ def test_walk_mcap_holds_every_channel_at_the_frame_rate_and_the_goals_the_servo
     logged = [list(angles_to_ticks(cfg, np.array(m.position), m.name)) for *_, m in log["/joint_goals"]]
     start = sent.index(logged[1]) - 1
     assert sent[start:start + len(logged)] == logged
+    # /joint_states: each mock servo reports the goal it was sent last (gaitbot.bus.dry_run), read one servo a
+    # frame in turn: every angle read back is, to half a tick, a goal its joint was logged with in the frames
+    # since its last read (one frame ahead too: /joint_goals shows the planned row before the one sent)
+    goal_rows, goal_times = np.array([m.position for *_, m in log["/joint_goals"]]), [t for t, *_ in log["/joint_goals"]]
+    half_tick_rad = 0.5 / np.array([j.model.ticks_per_rad for j in cfg.joints])
+    assert len(log["/joint_states"]) >= walk_frames - len(cfg.joints)  # from when every servo answered once
+    for t, _, _, states in log["/joint_states"]:
+        k = goal_times.index(t)
+        assert states.name == list(cfg.joint_names)
+        recent = goal_rows[max(0, k - 2 * len(cfg.joints)):k + 2]
+        assert np.all(np.abs(recent - np.array(states.position)).min(axis=0) <= half_tick_rad + 1e-12)
     # /tf: the pelvis walks the planned distance
     x = [m.transforms[0].transform.translation.x for *_, m in log["/tf"]]
     assert x[-1] - x[0] == pytest.approx(0.1, abs=0.01)
