@@ -151,3 +151,22 @@ def test_a_foxglove_client_watches_and_steers_a_simulated_drive():
     # a client that connected after the start still gets the robot to draw (sent again every 2 s)
     assert got["/robot_description"].data == urdf_text(config("op3"))
     assert {"left_foot", "right_foot", "trunk"} <= {t.child_frame_id for t in got["/tf_static"].transforms}
+
+
+@pytest.mark.slow
+def test_a_simulated_drive_logs_what_its_imu_felt(tmp_path, capsys):
+    """A drive whose feedback reads the IMU logs it a frame at a time: standing and walking on level ground,
+    the accelerometer's mean is gravity (9.81 m/s^2) along the torso's up axis, the gyro's mean about zero."""
+    commands, mcap = tmp_path / "c.jsonl", tmp_path / "d.mcap"
+    commands.write_text("".join(json.dumps(c) + "\n" for c in COMMANDS))
+    code, out, err = run_cli(capsys, "drive", "--robot", "op3", "--sim", "--input", f"commands:{commands}",
+                             "--json", "--mcap", mcap)
+    assert code == 0, err
+    log = read_back(mcap)
+    imu = [m for *_, m in log["/imu"]]
+    assert len(imu) == len(log["/joint_goals"])
+    assert np.allclose(np.diff([t for t, *_ in log["/imu"]]), 1e9 / 60, atol=1)
+    accel = np.array([[m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z] for m in imu])
+    gyro = np.array([[m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z] for m in imu])
+    assert accel.mean(axis=0) == pytest.approx([0.0, 0.0, 9.81], abs=0.3)
+    assert np.abs(gyro.mean(axis=0)).max() < 0.05  # rad/s: it sways, but comes back
