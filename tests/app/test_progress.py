@@ -42,7 +42,8 @@ def run_on_a_terminal(*args: str, cwd=REPO_ROOT, timeout: float = 120.0) -> tupl
 
 
 @pytest.mark.parametrize("args, words", [
-    (("walk", "--dry-run", "--realtime", "--steps", "0.02"), ("walking", "Ctrl-C stops safely", "frame")),
+    pytest.param(("walk", "--dry-run", "--realtime", "--steps", "0.02"), ("walking", "Ctrl-C stops safely", "frame"),
+                 marks=pytest.mark.slow),
     (("plan", "--terrain", str(CONFIG_DIR / "terrain" / "kerb.toml")), ("planning kerb.toml", "step")),
 ], ids=["real-time walk", "terrain planning"])
 def test_long_work_shows_its_progress_on_a_terminal(args, words):

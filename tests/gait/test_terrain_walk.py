@@ -143,10 +143,13 @@ def sweep(name):
     }
 
 
-#: The default robot's sweep runs in the quick loop; the other robots' (each robot's stated envelope figures
-#: walked again, a minute on two cores) in the slow set, which the full run and CI include.
+#: Two of the default robot's courses (a rise at the edge of its envelope) run in the quick loop; the rest of
+#: its sweep and the other robots' (each robot's stated envelope figures walked again, a minute on two cores)
+#: in the slow set, which the full run and CI include.
 QUICK_ROBOT = "xl430-biped"
-CASES = [pytest.param(name, case, id=f"{name}: {case}", marks=[] if name == QUICK_ROBOT else [pytest.mark.slow])
+QUICK_CASES = ("kerb at the largest rise", "up at the largest rise, shortest going")
+CASES = [pytest.param(name, case, id=f"{name}: {case}",
+                      marks=[] if name == QUICK_ROBOT and case in QUICK_CASES else [pytest.mark.slow])
          for name in ROBOTS for case in sweep(name)]
 
 
@@ -178,8 +181,10 @@ def example_walk(name: str, example: str):
 
 
 def _grouped(name: str, example: str):
-    """The default robot's stairs run on the worker of the ``stairs_walk`` tests, which reuse its walk."""
+    """The default robot's stairs run on the worker of the ``stairs_walk`` tests, which reuse its walk; the
+    default robot's examples are the quick loop's, the other robots' are slow."""
     marks = [pytest.mark.xdist_group("stairs-xl430")] if (name, example) == ("xl430-biped", "stairs") else []
+    marks += [] if name == QUICK_ROBOT else [pytest.mark.slow]
     return pytest.param(name, example, marks=marks, id=f"{example}-{name}")
 
 
@@ -228,6 +233,7 @@ def test_flat_steps_are_the_boulic_walkers(stairs_walk):
     assert inner.count("StepSegment") == len(flat)
 
 
+@pytest.mark.slow
 @pytest.mark.xdist_group("stairs-xl430")
 def test_grid_search_beats_the_middle_and_nears_brute_force(stairs_walk):
     _, walk, _ = stairs_walk

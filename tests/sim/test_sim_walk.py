@@ -110,6 +110,7 @@ def test_summary_names_the_measurements(capsys):
     assert "simulated robot" in out and "travelled" in out and "scuff" in out and "slip" in out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("suffix", (".gif", ".mp4"))
 def test_video_of_the_walk_is_written(suffix, tmp_path, capsys):
     path = tmp_path / f"walk{suffix}"
