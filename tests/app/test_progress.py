@@ -53,6 +53,7 @@ def test_long_work_shows_its_progress_on_a_terminal(args, words):
         assert word in terminal, terminal
 
 
+@pytest.mark.slow
 def test_eigen_fit_shows_its_progress_on_a_terminal(tmp_path):
     from gaitbot.app.cli import main
 

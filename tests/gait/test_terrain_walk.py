@@ -182,9 +182,10 @@ def example_walk(name: str, example: str):
 
 def _grouped(name: str, example: str):
     """The default robot's stairs run on the worker of the ``stairs_walk`` tests, which reuse its walk; the
-    default robot's examples are the quick loop's, the other robots' are slow."""
+    default robot's kerb and ditch are the quick loop's, the stairs (seconds of planning) and the other
+    robots' examples are slow."""
     marks = [pytest.mark.xdist_group("stairs-xl430")] if (name, example) == ("xl430-biped", "stairs") else []
-    marks += [] if name == QUICK_ROBOT else [pytest.mark.slow]
+    marks += [] if name == QUICK_ROBOT and example != "stairs" else [pytest.mark.slow]
     return pytest.param(name, example, marks=marks, id=f"{example}-{name}")
 
 
@@ -214,6 +215,7 @@ def stairs_walk():
     return example_walk("xl430-biped", "stairs")  # examples_for("xl430-biped") is EXAMPLES
 
 
+@pytest.mark.slow
 @pytest.mark.xdist_group("stairs-xl430")
 def test_stairs_up_and_down_are_one_walk(stairs_walk):
     course, walk, _ = stairs_walk
@@ -223,6 +225,7 @@ def test_stairs_up_and_down_are_one_walk(stairs_walk):
     assert walk.trajectory.root_m[-1, 0] == pytest.approx(walk.steps[-1].foothold_m + rb.geometry.heel_back, abs=1e-6)
 
 
+@pytest.mark.slow
 @pytest.mark.xdist_group("stairs-xl430")
 def test_flat_steps_are_the_boulic_walkers(stairs_walk):
     _, walk, _ = stairs_walk
