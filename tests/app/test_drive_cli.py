@@ -39,7 +39,7 @@ CASES = {"turn": {"vx": 0.0, "vy": 0.0, "wz": 10.0}, "sidestep": {"vx": 0.0, "vy
 
 
 @pytest.mark.parametrize("mode", slow_except(["--dry-run", "--sim"], "--dry-run"))
-@pytest.mark.parametrize("case", slow_except(CASES, "arc"))
+@pytest.mark.parametrize("case", slow_except(CASES))
 def test_a_commands_file_drive_ends_where_the_commands_say(tmp_path, mode, case):
     """The report's pose (planned on the mock bus, measured in the free-floating simulation) against the
     commands integrated on their own, within 25% of the commanded displacement and turn; no fall; the
@@ -63,6 +63,7 @@ def test_a_commands_file_drive_ends_where_the_commands_say(tmp_path, mode, case)
     check_ok(record)
 
 
+@pytest.mark.slow
 def test_identical_drives_give_byte_identical_recordings_and_commands_record_reads_back(tmp_path):
     path = commands_file(tmp_path, "arc", [{"t": 0.0, "vx": 0.03, "vy": 0.0, "wz": 6.0}, {"t": 4.0, "stop": True}])
     outputs = []

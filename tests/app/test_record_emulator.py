@@ -148,6 +148,7 @@ def wait_for_rows(path: Path, rows: int, process: subprocess.Popen, timeout_s: f
     raise AssertionError(f"no {rows} rows within {timeout_s} s")
 
 
+@pytest.mark.slow
 def test_cli_records_for_a_duration_in_real_time(tmp_path):
     config = load_robot("xl430-biped")
     _, ticks = script(config, 0.06, n_steps=2)
@@ -178,6 +179,7 @@ def test_a_signal_ends_the_recording_with_every_row_read(tmp_path, sig, code, wo
     assert len(got) >= 40 and np.abs(got - ticks[:len(got)]).max() <= 1
 
 
+@pytest.mark.slow
 def test_a_port_that_disappears_ends_with_exit_1_and_a_readable_file(tmp_path):
     config = load_robot("xl430-biped")
     _, ticks = script(config, 0.06)

@@ -57,7 +57,7 @@ def help_examples():
 
 #: The commands whose ``--help`` examples run in the quick loop (a second or so each); the others plan, simulate
 #: or fit for seconds each, and are slow like the pages' commands.
-QUICK_HELP = ("calibrate", "check", "record", "scan", "setup")
+QUICK_HELP = ("calibrate", "record", "scan", "setup")
 
 
 @pytest.mark.parametrize("name", [n if n in QUICK_HELP else pytest.param(n, marks=pytest.mark.slow)

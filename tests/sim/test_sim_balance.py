@@ -91,6 +91,7 @@ def test_mass_model_matches_mujoco():
         assert np.abs(tau[:6] - robot.data.qfrc_bias[dofs]).max() < 1e-9
 
 
+@pytest.mark.slow
 def test_op3_walks_2_m_free_floating_within_the_targets(capsys):
     code, r = sim(capsys, "--robot", "op3", "--distance", "2")
     assert code == 0 and r["support"] == "free"

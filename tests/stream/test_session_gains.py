@@ -214,7 +214,7 @@ def test_the_limit_guard_passes_settings_on():
 
 # --- a real pty: the emulator keeps what it was sent ----------------------------------------------
 
-@pytest.mark.parametrize("name", slow_except(sorted(EXPECTED), "xl430-biped"))
+@pytest.mark.parametrize("name", slow_except(sorted(EXPECTED)))
 def test_the_emulator_receives_the_gain_registers(name, tmp_path):
     _, _, gains = EXPECTED[name]
     config = load_robot_config(CONFIG_DIR / f"{name}.toml")
