@@ -14,7 +14,30 @@ REAL_TIME_MODULES = {"test_emulator_e2e.py", "test_record_emulator.py", "test_wa
                      "test_session_gains.py"}
 
 
-def pytest_collection_modifyitems(items):
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.path.name in REAL_TIME_MODULES:
             item.add_marker(pytest.mark.xdist_group("real-time"))
+    if getattr(config.option, "loadgroup", False):  # a pytest-xdist worker, --dist loadgroup
+        for item in items:
+            _name_its_group(item)
+
+
+def _name_its_group(item) -> None:
+    """What pytest-xdist's loadgroup does on a worker (the group's name after an "@" in the test's id, which
+    its scheduler reads), for the tests it left without: those whose group is added above, after its own
+    hook ran, and every test under pytest 9, where its writing of the id no longer takes effect
+    (pytest-xdist issue 1386), so that the groups were silently ignored."""
+    names = sorted({str(m.args[0] if m.args else m.kwargs.get("name", "default"))
+                    for m in item.iter_markers("xdist_group")})
+    nodeid = item.nodeid
+    if not names or nodeid.rfind("@") > nodeid.rfind("]"):
+        return
+    grouped = f"{nodeid}@{'_'.join(names)}"
+    if hasattr(item, "_id"):  # pytest 9: a structured id
+        from _pytest.nodes import coerce_node_id
+
+        item._id = coerce_node_id(grouped)
+    else:
+        item._nodeid = grouped
