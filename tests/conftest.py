@@ -3,6 +3,12 @@
 Tests mirror the packages (tests/servos, gait, robot, bus, stream, check, sim, app); helpers.py holds
 what several of them use. No test imports another test file, and the emulator is imported as the
 module it is (gaitbot.emulator), never loaded by file path.
+
+The slow mark (pyproject.toml) keeps the quick loop, ``pytest -q -m "not slow"``, to a couple of minutes on
+two cores: slow are the figure re-derivations and the docs' commands, long simulated and real-time walks,
+videos, fuzzing, and the other robots, protocols and faults of a behaviour one case of which stays quick
+(``helpers.slow_except``). Every safety path keeps a quick case: a dry-run walk, a fault's stop ramp, a
+limit refusal, a signal. Expensive work several tests judge is made once (session or grouped fixtures).
 """
 
 import pytest
