@@ -17,7 +17,7 @@ import pytest
 #: time (pytest-xdist's loadgroup), since two real-time walks on a 2-core host delay replies past the SDK's
 #: timeouts, which the driver rightly reports as servos answering late.
 REAL_TIME_MODULES = {"test_emulator_e2e.py", "test_record_emulator.py", "test_walk_signals.py",
-                     "test_session_gains.py"}
+                     "test_session_gains.py", "test_faults_emulator.py", "test_bringup_e2e.py"}
 
 
 @pytest.hookimpl(trylast=True)

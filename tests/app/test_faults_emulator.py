@@ -30,7 +30,7 @@ FAULT_FRAME = 120
 #: the servo each scenario hurts: ankle_pitch_left (id 3) on xl430 and sts3215, knee_pitch_left (13) on ax12a
 VICTIM = {"xl430-biped": 3, "sts3215-biped": 3, "ax12a-biped": 13}
 
-pytestmark = pytest.mark.xdist_group("emulator")
+pytestmark = pytest.mark.xdist_group("real-time")  # one real-time walk at a time (tests/conftest.py)
 
 
 def scenario(robot: str, kind: str, mid_walk: bool = True):
