@@ -21,6 +21,7 @@ import traceback
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from gaitbot.app.cli import main
 from gaitbot.errors import UserError
@@ -30,6 +31,25 @@ from gaitbot.servos import wire
 REPO_ROOT = Path(__file__).resolve().parents[1]
 CONFIG_DIR = REPO_ROOT / "config"
 WALK_TIMEOUT_S = 60  # a hang fails the test instead of the suite
+
+
+def slow_except(values, *quick):
+    """A parametrize list whose cases all go to the slow set except those in ``quick``: the quick loop keeps
+    one representative of a behaviour, the full run (and CI) every robot, protocol and fault. A case is kept
+    quick when it, its first argument (a tuple is a case of several arguments) or its ``pytest.param`` id is
+    a name in ``quick``; a ``pytest.param`` keeps its id and marks."""
+    cases = []
+    for value in values:
+        is_param = isinstance(value, type(pytest.param(None)))
+        args = value.values if is_param else value if isinstance(value, tuple) else (value,)
+        names = {v for v in (value, args[0], value.id if is_param else None) if isinstance(v, str)}
+        if names & set(quick):
+            cases.append(value)
+        else:
+            marks = [*value.marks, pytest.mark.slow] if is_param else [pytest.mark.slow]
+            cases.append(pytest.param(*args, id=value.id if is_param else None, marks=marks))
+    return cases
+
 
 # --- the command line and the emulator
 

@@ -271,6 +271,7 @@ def test_walk_with_a_mutated_robot_config(text, tmp_path_factory):
     assert_walk_behaves(cli("walk", "--dry-run", "--distance", "0.1", "--robot", path))
 
 
+@pytest.mark.slow
 @FUZZ
 @given(text=toml_mutation(KERB))  # the kerb: planning the stairs alone takes seconds on a loaded machine
 def test_plan_with_a_mutated_course(text, tmp_path_factory):
@@ -290,6 +291,7 @@ def test_check_with_a_mutated_file(data, kind, base, tmp_path_factory):
     assert_cli_behaves(cli("check", "--allow-partial", path), allowed=(0, 1, 2))
 
 
+@pytest.mark.slow
 @FUZZ
 @given(data=st.data())
 def test_eigen_synth_with_a_mutated_model(data, base, tmp_path_factory):
@@ -319,6 +321,7 @@ def test_walk_options_with_hostile_numbers(option, value, command, tmp_path_fact
         assert_cli_behaves(result)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(option=st.sampled_from(["--cycles", "--components", "--step-length", "--to-step-length", "--pose-time"]),
        value=st.sampled_from(HOSTILE_NUMBERS + ["100000000", "-5", "3.5"]))
@@ -348,6 +351,7 @@ FIT_OPTIONS = ["--samples", "--n-basis", "--roughness", "--pose-variance", "--po
                "--components", "--label-degree"]
 
 
+@pytest.mark.slow
 @settings(FUZZ, max_examples=max(5, EXAMPLES // 2))
 @given(option=st.sampled_from(FIT_OPTIONS), value=st.sampled_from(HOSTILE_NUMBERS + ["100000000", "2", "-5"]))
 def test_eigen_fit_with_hostile_numbers(option, value, base, tmp_path_factory):
@@ -356,6 +360,7 @@ def test_eigen_fit_with_hostile_numbers(option, value, base, tmp_path_factory):
     assert_cli_behaves(cli("eigen", "fit", *examples, f"{option}={value}", "-o", out))
 
 
+@pytest.mark.slow
 @settings(FUZZ, max_examples=max(5, EXAMPLES // 2))
 @given(data=st.data(), kind=st.sampled_from(["csv", "npz"]))
 def test_eigen_fit_with_a_mutated_example(data, kind, base, tmp_path_factory):
@@ -367,6 +372,7 @@ def test_eigen_fit_with_a_mutated_example(data, kind, base, tmp_path_factory):
     assert_cli_behaves(cli("eigen", "fit", *examples, path, "-o", path.parent / "m.npz"))
 
 
+@pytest.mark.slow
 @FUZZ
 @given(option=st.sampled_from(["--duration", "--reply-timeout-ms"]), value=st.sampled_from(HOSTILE_NUMBERS))
 def test_record_with_hostile_numbers(option, value, tmp_path_factory):
@@ -379,6 +385,7 @@ EMULATOR_FLAGS = ["--late", "--error", "--silent", "--corrupt", "--fault-after-f
                   "--close-after-frames", "--close-after-s", "--baudrate", "--return-delay-us", "--ids", "--hand-rate"]
 
 
+@pytest.mark.slow
 @FUZZ
 @given(flag=st.sampled_from(EMULATOR_FLAGS),
        value=st.sampled_from(HOSTILE_NUMBERS + ["3:100", "9:100", "3:abc", "3:-5", "3:nan", "x:1", "3:overload",

@@ -25,7 +25,7 @@ from gaitbot.robot.calibration_file import read_calibration
 from gaitbot.servos import baud_register_value, factory_baudrate
 from gaitbot.servos.health import health_block
 from gaitbot.servos.models import SERVO_MODELS
-from helpers import REPO_ROOT, config
+from helpers import REPO_ROOT, config, slow_except
 
 ROBOTS = {"dxl2": "xl430-biped", "dxl1": "ax12a-biped", "feetech": "sts3215-biped"}
 SET_UP = {"dxl2": None, "dxl1": 1, "feetech": None}  # joints set up (None: all)
@@ -81,7 +81,7 @@ def setup(robot, emulator, joints, *extra):
 # --------------------------------------------------------------------------- setup
 
 
-@pytest.mark.parametrize("protocol", ["dxl2", "dxl1", "feetech"])
+@pytest.mark.parametrize("protocol", slow_except(["dxl2", "dxl1", "feetech"], "dxl1"))
 def test_setup_gives_factory_fresh_servos_the_configs_ids_and_baud_rate(protocol):
     robot = config(ROBOTS[protocol])
     joints = robot.joints[:SET_UP[protocol]]
@@ -109,6 +109,7 @@ def test_setup_gives_factory_fresh_servos_the_configs_ids_and_baud_rate(protocol
         assert f"{len(joints)} of {len(joints)} servos set up" in out
 
 
+@pytest.mark.slow
 def test_setup_on_the_emulator_command_line_plugged_with_enter(tmp_path):
     """The user's way: tools/servo_emulator.py --factory-fresh --one-at-a-time, Enter there plugs the next servo."""
     robot = config("xl430-biped")
@@ -143,7 +144,7 @@ def test_setup_on_the_emulator_command_line_plugged_with_enter(tmp_path):
         emu.wait(timeout=10)
 
 
-@pytest.mark.parametrize("protocol", ["dxl2", "feetech"])
+@pytest.mark.parametrize("protocol", slow_except(["dxl2", "feetech"], "dxl2"))
 def test_two_servos_on_the_bus_are_refused_in_one_line_with_nothing_written(protocol):
     robot = config(ROBOTS[protocol])
     with fresh_emulator(robot, 2, one_at_a_time=False) as emulator:
@@ -153,6 +154,7 @@ def test_two_servos_on_the_bus_are_refused_in_one_line_with_nothing_written(prot
         assert emulator.chain.writes == []
 
 
+@pytest.mark.slow
 def test_two_servos_on_a_protocol1_bus_are_refused_too():
     robot = config("ax12a-biped")
     with fresh_emulator(robot, 2, one_at_a_time=False) as emulator:
@@ -185,7 +187,7 @@ def scripted_hand(robot, seed_offset=0):
     return zero, direction, se.Hand({i: [r[i] for r in rows] for i in zero})
 
 
-@pytest.mark.parametrize("protocol", ["dxl2", "dxl1", "feetech"])
+@pytest.mark.parametrize("protocol", slow_except(["dxl2", "dxl1", "feetech"], "dxl2"))
 def test_calibrate_with_a_scripted_hand_gives_back_its_zero_ticks_and_directions(protocol, tmp_path):
     robot = config(ROBOTS[protocol])
     zero, direction, hand = scripted_hand(robot, len(protocol))
@@ -211,7 +213,7 @@ def test_calibrate_with_a_scripted_hand_gives_back_its_zero_ticks_and_directions
 # --------------------------------------------------------------------------- scan
 
 
-@pytest.mark.parametrize("protocol", ["dxl2", "dxl1", "feetech"])
+@pytest.mark.parametrize("protocol", slow_except(["dxl2", "dxl1", "feetech"], "dxl2"))
 def test_scan_lists_what_the_emulator_holds(protocol):
     robot = config(ROBOTS[protocol])
     models = dict(robot.models_by_id)
@@ -257,7 +259,7 @@ def walk_on(robot, emulator_config, tmp_path):
     return proc, record, check
 
 
-@pytest.mark.parametrize("protocol", ["dxl2", "dxl1", "feetech"])
+@pytest.mark.parametrize("protocol", slow_except(["dxl2", "dxl1", "feetech"], "dxl2"))
 def test_a_servo_heating_past_its_limit_stops_the_walk_safely_and_check_reports_it(protocol, tmp_path):
     robot = config(ROBOTS[protocol])
     knee = robot.joint("knee_pitch_left")
@@ -280,7 +282,7 @@ def test_a_servo_heating_past_its_limit_stops_the_walk_safely_and_check_reports_
     assert (hottest["id"], hottest["temperature_c"]) == (knee.id, stop_c)
 
 
-@pytest.mark.parametrize("protocol", ["dxl2", "dxl1", "feetech"])
+@pytest.mark.parametrize("protocol", slow_except(["dxl2", "dxl1", "feetech"]))
 def test_a_sagging_supply_stops_the_walk_safely_and_check_reports_it(protocol, tmp_path):
     robot = config(ROBOTS[protocol])
     stop_v = {"dxl2": 6.5, "dxl1": 9.0, "feetech": 6.0}[protocol]

@@ -204,6 +204,7 @@ def test_negative_margin(capsys, walks):
 # ----------------------------------------------------------------------------------------- the tool and the real command
 
 
+@pytest.mark.slow
 def test_tool_script_same_exit_codes(tmp_path, walks):
     tool = REPO / "tools" / "check_trajectory.py"
     table = load(walks["xl430-biped"])

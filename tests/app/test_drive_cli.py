@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers import REPO_ROOT, gaitbot
+from helpers import REPO_ROOT, gaitbot, slow_except
 
 from gaitbot.app.steer_walk import commanded_pose
 from gaitbot.gait.steer.command import read_commands
@@ -38,8 +38,8 @@ CASES = {"turn": {"vx": 0.0, "vy": 0.0, "wz": 10.0}, "sidestep": {"vx": 0.0, "vy
          "backwards": {"vx": -0.04, "vy": 0.0, "wz": 0.0}, "arc": {"vx": 0.04, "vy": 0.0, "wz": -8.0}}
 
 
-@pytest.mark.parametrize("mode", ["--dry-run", "--sim"])
-@pytest.mark.parametrize("case", CASES)
+@pytest.mark.parametrize("mode", slow_except(["--dry-run", "--sim"], "--dry-run"))
+@pytest.mark.parametrize("case", slow_except(CASES))
 def test_a_commands_file_drive_ends_where_the_commands_say(tmp_path, mode, case):
     """The report's pose (planned on the mock bus, measured in the free-floating simulation) against the
     commands integrated on their own, within 25% of the commanded displacement and turn; no fall; the
@@ -63,6 +63,7 @@ def test_a_commands_file_drive_ends_where_the_commands_say(tmp_path, mode, case)
     check_ok(record)
 
 
+@pytest.mark.slow
 def test_identical_drives_give_byte_identical_recordings_and_commands_record_reads_back(tmp_path):
     path = commands_file(tmp_path, "arc", [{"t": 0.0, "vx": 0.03, "vy": 0.0, "wz": 6.0}, {"t": 4.0, "stop": True}])
     outputs = []
@@ -112,6 +113,7 @@ def test_ctrl_c_mid_step_stands_exits_130_and_the_recording_passes_check(tmp_pat
     check_ok(record)
 
 
+@pytest.mark.slow
 def test_keys_on_a_pty_drive_the_robot(tmp_path):
     """W (forward) written to the pty that is the drive's standard input walks it forward; space stands it."""
     main, secondary = pty.openpty()

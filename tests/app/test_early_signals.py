@@ -50,7 +50,8 @@ def start_then_signal(signum: int, delay_s: float) -> subprocess.CompletedProces
     return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
 
 
-@pytest.mark.parametrize("signum, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+@pytest.mark.parametrize("signum, status", [(signal.SIGINT, 130),
+                                            pytest.param(signal.SIGTERM, 143, marks=pytest.mark.slow)])
 def test_a_signal_while_starting_is_one_line_and_the_signal_status(signum, status):
     rng = np.random.default_rng(26)
     for delay_s in rng.uniform(0.0, 0.15, size=6):

@@ -22,7 +22,7 @@ from gaitbot.bus.recording import decode_goal_frames
 from gaitbot.robot.config import load_robot_config
 
 import gaitbot.emulator as se  # noqa: E402 - the emulator, imported as a module
-from helpers import REPO_ROOT, emulator_for, gaitbot
+from helpers import REPO_ROOT, emulator_for, gaitbot, slow_except
 
 ROOT = REPO_ROOT
 CONFIGS = {"dxl2": ROOT / "config" / "xl430-biped.toml", "dxl1": ROOT / "config" / "ax12a-biped.toml",
@@ -67,7 +67,7 @@ def dry_run_ticks(config_path: Path, workdir: Path, walk_args: list[str]) -> np.
 
 # --------------------------------------------------------------------------- full walks
 
-@pytest.mark.parametrize("protocol", ["dxl1", "dxl2", "feetech-sts", "feetech-scs"])
+@pytest.mark.parametrize("protocol", slow_except(["dxl1", "dxl2", "feetech-sts", "feetech-scs"], "dxl2"))
 def test_walk_through_the_emulator_sends_exactly_the_dry_run_goals(tmp_path, protocol):
     """One short walk per protocol (each shipped config, plus an SCS0009 biped), each its own test so that
     they spread over the workers. Every goal frame of the walk (the start ramp, the steps, the final ramp)
@@ -114,8 +114,10 @@ def test_a_servo_that_never_answers_stops_before_anything_moves(tmp_path):
 
 @pytest.mark.parametrize("fault, words", [
     (se.Faults(silent={3}, after_frames=FAULT_FRAME), ("servo 3", "did not answer", "read-backs in a row")),
-    (se.Faults(late_s={3: 0.06}, after_frames=FAULT_FRAME), ("servo 3", "answers late", "ms after the request")),
-    (se.Faults(corrupt_fraction=1.0, corrupt_ids={3}, after_frames=FAULT_FRAME), ("servo 3", "damaged status packet")),
+    pytest.param(se.Faults(late_s={3: 0.06}, after_frames=FAULT_FRAME), ("servo 3", "answers late", "ms after the request"),
+                 marks=pytest.mark.slow),
+    pytest.param(se.Faults(corrupt_fraction=1.0, corrupt_ids={3}, after_frames=FAULT_FRAME),
+                 ("servo 3", "damaged status packet"), marks=pytest.mark.slow),
 ], ids=["silent", "late", "corrupt"])
 def test_servo_fault_mid_walk_stops_within_the_bound_at_stand(tmp_path, fault, words):
     proc, emulator_ticks, record, elapsed = walk_through_emulator(CONFIGS["dxl2"], tmp_path, SHORT, fault)
@@ -125,11 +127,11 @@ def test_servo_fault_mid_walk_stops_within_the_bound_at_stand(tmp_path, fault, w
     assert len(emulator_ticks) < 200  # stopped long before the 276-frame walk would have ended
 
 
-@pytest.mark.parametrize("protocol, kind, words", [
+@pytest.mark.parametrize("protocol, kind, words", slow_except([
     ("dxl2", "overload", "reports overload"),
     ("dxl1", "overheating", "reports overheating"),
     ("feetech-sts", "voltage", "reports input voltage"),
-])
+], "dxl2"))
 def test_status_error_bits_stop_the_walk_naming_servo_and_fault(tmp_path, protocol, kind, words):
     servo = load_robot_config(CONFIGS[protocol]).joints[1].id
     faults = se.Faults(errors={servo: {kind}}, after_frames=FAULT_FRAME)
@@ -147,6 +149,7 @@ def test_a_port_that_disappears_mid_walk_ends_at_once_with_a_complete_recording(
     assert t_s[-1] - t_s[FAULT_FRAME + 9] < 0.5
 
 
+@pytest.mark.slow
 def test_rare_damaged_replies_are_retried_and_the_walk_completes(tmp_path):
     faults = se.Faults(corrupt_fraction=0.05)
     proc, emulator_ticks, _record, _elapsed = walk_through_emulator(CONFIGS["dxl1"], tmp_path, SHORT, faults)
@@ -154,6 +157,7 @@ def test_rare_damaged_replies_are_retried_and_the_walk_completes(tmp_path):
     np.testing.assert_array_equal(emulator_ticks, dry_run_ticks(CONFIGS["dxl1"], tmp_path, SHORT))
 
 
+@pytest.mark.slow
 def test_extra_latency_within_the_timeout_is_tolerated(tmp_path):
     """4 ms late on two servos, well inside the timeout. The timeout is 250 ms here (as for the full walks
     above), not the SDK's 34 ms: on a busy 2-core host a scheduling stall of 30 ms on top of the 4 ms was

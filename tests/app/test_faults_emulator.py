@@ -24,13 +24,13 @@ from gaitbot.bus.recording import decode_goal_frames
 from gaitbot.check.trajectory import check_trajectory
 from gaitbot.robot.calibration import ticks_to_angles
 from gaitbot.robot.config import load_robot_config
-from helpers import CONFIG_DIR, emulator_for, gaitbot
+from helpers import CONFIG_DIR, emulator_for, gaitbot, slow_except
 
 FAULT_FRAME = 120
 #: the servo each scenario hurts: ankle_pitch_left (id 3) on xl430 and sts3215, knee_pitch_left (13) on ax12a
 VICTIM = {"xl430-biped": 3, "sts3215-biped": 3, "ax12a-biped": 13}
 
-pytestmark = pytest.mark.xdist_group("emulator")
+pytestmark = pytest.mark.xdist_group("real-time")  # one real-time walk at a time (tests/conftest.py)
 
 
 def scenario(robot: str, kind: str, mid_walk: bool = True):
@@ -47,6 +47,8 @@ SCENARIOS = [scenario("xl430-biped", kind) for kind in ("late", "silent", "overl
     scenario("xl430-biped", "late", mid_walk=False), scenario("ax12a-biped", "late"),
     scenario("ax12a-biped", "late", mid_walk=False), scenario("sts3215-biped", "silent"),
     scenario("sts3215-biped", "overload")]
+#: The quick loop keeps one fault's stop ramp; the full run every robot and fault.
+SCENARIOS = slow_except(SCENARIOS, "xl430-biped-overload-mid-walk")
 
 
 def grid_limit_errors(config, ticks: np.ndarray, from_frame: int) -> list[str]:

@@ -16,6 +16,8 @@ from helpers import REPO_ROOT, knee_calibration, run_cli
 
 STAIRS = REPO_ROOT / "config" / "terrain" / "stairs.toml"
 KERB = REPO_ROOT / "config" / "terrain" / "kerb.toml"
+#: One worker runs this module, so that the files below (a stairs walk among them) are made once.
+pytestmark = pytest.mark.xdist_group("file-origin")
 
 
 @pytest.fixture(scope="module")

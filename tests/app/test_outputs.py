@@ -38,6 +38,7 @@ def test_walk_does_not_record_over_the_trajectory_it_plays(walk_csv, tmp_path):
     assert walk_csv.read_bytes() == before
 
 
+@pytest.mark.slow
 def test_eigen_fit_does_not_write_its_model_over_an_example(walk_csv, tmp_path):
     example = tmp_path / "ex.npz"
     assert gaitbot("generate", "--steps", "0.05,0.05,0.05,0.05", "-o", str(example)).returncode == 0

@@ -45,6 +45,7 @@ def run_on_a_terminal(*args: str, cwd=REPO_ROOT, timeout: float = 120.0) -> tupl
     (("walk", "--dry-run", "--realtime", "--steps", "0.02"), ("walking", "Ctrl-C stops safely", "frame")),
     (("plan", "--terrain", str(CONFIG_DIR / "terrain" / "kerb.toml")), ("planning kerb.toml", "step")),
 ], ids=["real-time walk", "terrain planning"])
+@pytest.mark.slow
 def test_long_work_shows_its_progress_on_a_terminal(args, words):
     status, terminal = run_on_a_terminal(*args)
     assert status == 0, terminal
@@ -52,6 +53,7 @@ def test_long_work_shows_its_progress_on_a_terminal(args, words):
         assert word in terminal, terminal
 
 
+@pytest.mark.slow
 def test_eigen_fit_shows_its_progress_on_a_terminal(tmp_path):
     from gaitbot.app.cli import main
 
@@ -63,7 +65,8 @@ def test_eigen_fit_shows_its_progress_on_a_terminal(tmp_path):
 
 
 @pytest.mark.parametrize("args", [("walk", "--dry-run", "--steps", "0.02"),
-                                  ("plan", "--terrain", str(CONFIG_DIR / "terrain" / "kerb.toml"))])
+                                  pytest.param(("plan", "--terrain", str(CONFIG_DIR / "terrain" / "kerb.toml")),
+                                               marks=pytest.mark.slow)])
 def test_nothing_of_it_when_stderr_is_not_a_terminal(args):
     proc = subprocess.run([sys.executable, "-m", "gaitbot", *args], capture_output=True, text=True, cwd=REPO_ROOT,
                           timeout=120)

@@ -35,7 +35,7 @@ from gaitbot.robot.walk_settings import leg_geometry, walk_settings
 from gaitbot.app.options import load_robot
 
 import gaitbot.emulator as se  # noqa: E402 - the emulator, imported as a module
-from helpers import REPO_ROOT
+from helpers import REPO_ROOT, slow_except
 
 ROOT = REPO_ROOT
 REPLY_TIMEOUT_MS = 250
@@ -69,9 +69,10 @@ def recorded_ticks(config, trajectory) -> np.ndarray:
     return angles_to_ticks(config, trajectory.angles_rad)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def recorded_walks(tmp_path_factory):
-    """The XL430 biped: three walks recorded one after the other."""
+    """The XL430 biped: three walks recorded one after the other (once per worker: the real-time tests of
+    several modules interleave on it, which would set up a module's fixture again)."""
     config = load_robot("xl430-biped")
     base = tmp_path_factory.mktemp("recorded")
     out = {}
@@ -82,6 +83,7 @@ def recorded_walks(tmp_path_factory):
     return config, out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("step", STEPS)
 def test_recording_gives_back_the_hand_motion_to_one_tick(recorded_walks, step):
     config, walks = recorded_walks
@@ -98,6 +100,7 @@ def test_recording_gives_back_the_hand_motion_to_one_tick(recorded_walks, step):
     assert abs(travel - walker_travel) < 0.02 * walker_travel + 0.003
 
 
+@pytest.mark.slow
 def test_recorded_walks_can_be_fitted(recorded_walks, tmp_path, capsys):
     config, walks = recorded_walks
     paths = [str(walks[s][2]) for s in STEPS]
@@ -114,7 +117,7 @@ def test_recorded_walks_can_be_fitted(recorded_walks, tmp_path, capsys):
     assert main(["check", str(walk_csv), "--robot", "xl430-biped"]) == 0
 
 
-@pytest.mark.parametrize("robot", ["ax12a-biped", "sts3215-biped"])
+@pytest.mark.parametrize("robot", slow_except(["ax12a-biped", "sts3215-biped"], "sts3215-biped"))
 def test_other_protocols_read_the_hand_to_one_tick(tmp_path, robot):
     """Dynamixel 1.0 (one read per servo) and Feetech STS (its sync read): the hand cycle counts them alike."""
     config = load_robot(robot)
@@ -145,6 +148,7 @@ def wait_for_rows(path: Path, rows: int, process: subprocess.Popen, timeout_s: f
     raise AssertionError(f"no {rows} rows within {timeout_s} s")
 
 
+@pytest.mark.slow
 def test_cli_records_for_a_duration_in_real_time(tmp_path):
     config = load_robot("xl430-biped")
     _, ticks = script(config, 0.06, n_steps=2)
@@ -158,7 +162,8 @@ def test_cli_records_for_a_duration_in_real_time(tmp_path):
     assert len(got) == 90 and np.abs(got - ticks[:90]).max() <= 1
 
 
-@pytest.mark.parametrize("sig, code, words", [(signal.SIGTERM, 143, "terminated"), (signal.SIGINT, 0, "stopped")])
+@pytest.mark.parametrize("sig, code, words", [(signal.SIGTERM, 143, "terminated"),
+                                               pytest.param(signal.SIGINT, 0, "stopped", marks=pytest.mark.slow)])
 def test_a_signal_ends_the_recording_with_every_row_read(tmp_path, sig, code, words):
     config = load_robot("xl430-biped")
     _, ticks = script(config, 0.06)
@@ -174,6 +179,7 @@ def test_a_signal_ends_the_recording_with_every_row_read(tmp_path, sig, code, wo
     assert len(got) >= 40 and np.abs(got - ticks[:len(got)]).max() <= 1
 
 
+@pytest.mark.slow
 def test_a_port_that_disappears_ends_with_exit_1_and_a_readable_file(tmp_path):
     config = load_robot("xl430-biped")
     _, ticks = script(config, 0.06)

@@ -66,6 +66,7 @@ def broken(draw):
     return name, "\n".join(lines)
 
 
+@pytest.mark.slow
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(broken())
 def test_the_importer_writes_a_loadable_config_or_refuses_in_one_line(case):

@@ -45,7 +45,7 @@ def goal_frames(recording: Path, protocol: float, goal_len: int, big_endian: boo
     return header, np.array(times), frames
 
 
-@pytest.mark.parametrize("config_path", CONFIGS, ids=lambda p: p.stem)
+@pytest.mark.parametrize("config_path", [c if c.stem == "xl430-biped" else pytest.param(c, marks=pytest.mark.slow) for c in CONFIGS], ids=lambda p: p.stem)
 def test_dry_run_recording_matches_generate(config_path, tmp_path, capsys):
     config = load_robot_config(config_path)
     record, csv = tmp_path / "run.jsonl", tmp_path / "walk.csv"

@@ -55,7 +55,13 @@ def help_examples():
     return {"gaitbot": top, **{name: list(text.examples) for name, text in COMMAND_HELP.items()}}
 
 
-@pytest.mark.parametrize("name", sorted(help_examples()))
+#: The commands whose ``--help`` examples run in the quick loop (a second or so each); the others plan, simulate
+#: or fit for seconds each, and are slow like the pages' commands.
+QUICK_HELP = ("calibrate", "record", "scan", "setup")
+
+
+@pytest.mark.parametrize("name", [n if n in QUICK_HELP else pytest.param(n, marks=pytest.mark.slow)
+                                  for n in sorted(help_examples())])
 def test_help_examples_run(name, tmp_path):
     prepare_folder(tmp_path)
     commands = [Command(f"gaitbot {name} --help", 0, line) for line in help_examples()[name]]

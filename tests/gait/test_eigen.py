@@ -202,6 +202,7 @@ def test_bspline_fits_a_start_from_standing_that_a_fourier_basis_cannot():
     assert np.abs(err_f[[0, -1]]).max() > 1.0
 
 
+@pytest.mark.slow
 def test_a_non_periodic_model_learns_starts_at_eight_step_lengths_and_synthesises_those_between():
     """Starts from standing at the 8 training step lengths, B-spline fPCA (periodic=False): the start at a
     held-out step length within 0.6 deg RMS of the walker's own, beginning at the standing pose."""
@@ -371,6 +372,7 @@ def test_cli_fit_synth_check_plot(files, capsys):
     assert walk_csv.angles_deg[-1] == pytest.approx(np.zeros(6), abs=1e-6)  # ends standing
 
 
+@pytest.mark.slow
 def test_cli_pose_constraint(files, capsys):
     """The pose a 0.065 m walk takes 0.567 s after a left heel strike, forced on a 0.05 m walk at that time."""
     d, paths = files
@@ -392,6 +394,7 @@ def test_cli_pose_constraint(files, capsys):
     assert np.abs(steady_step_lengths(tr) - 0.065).max() < 0.005  # the pose brings its step length along
 
 
+@pytest.mark.slow
 def test_cli_a_forced_pose_that_distorts_the_walk_is_written_but_flagged(files, tmp_path, capsys):
     d, paths = files
     model = str(tmp_path / "m.npz")

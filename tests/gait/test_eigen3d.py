@@ -238,6 +238,7 @@ def test_a_pose_angle_outside_its_joints_limits_is_named(model_path, folder, cap
     one_line_error(capsys, "hip_roll_left", "limits")
 
 
+@pytest.mark.slow
 def test_plot_draws_the_joints_that_move_and_names_the_still_ones(model_path, folder):
     out = folder / "model.png"
     assert main(["plot", model_path, "-o", str(out)]) == 0

@@ -143,10 +143,13 @@ def sweep(name):
     }
 
 
-#: The default robot's sweep runs in the quick loop; the other robots' (each robot's stated envelope figures
-#: walked again, a minute on two cores) in the slow set, which the full run and CI include.
+#: Two of the default robot's courses (a rise at the edge of its envelope) run in the quick loop; the rest of
+#: its sweep and the other robots' (each robot's stated envelope figures walked again, a minute on two cores)
+#: in the slow set, which the full run and CI include.
 QUICK_ROBOT = "xl430-biped"
-CASES = [pytest.param(name, case, id=f"{name}: {case}", marks=[] if name == QUICK_ROBOT else [pytest.mark.slow])
+QUICK_CASES = ("kerb at the largest rise", "up at the largest rise, shortest going")
+CASES = [pytest.param(name, case, id=f"{name}: {case}",
+                      marks=[] if name == QUICK_ROBOT and case in QUICK_CASES else [pytest.mark.slow])
          for name in ROBOTS for case in sweep(name)]
 
 
@@ -178,8 +181,11 @@ def example_walk(name: str, example: str):
 
 
 def _grouped(name: str, example: str):
-    """The default robot's stairs run on the worker of the ``stairs_walk`` tests, which reuse its walk."""
+    """The default robot's stairs run on the worker of the ``stairs_walk`` tests, which reuse its walk; the
+    default robot's kerb and ditch are the quick loop's, the stairs (seconds of planning) and the other
+    robots' examples are slow."""
     marks = [pytest.mark.xdist_group("stairs-xl430")] if (name, example) == ("xl430-biped", "stairs") else []
+    marks += [] if name == QUICK_ROBOT and example != "stairs" else [pytest.mark.slow]
     return pytest.param(name, example, marks=marks, id=f"{example}-{name}")
 
 
@@ -209,6 +215,7 @@ def stairs_walk():
     return example_walk("xl430-biped", "stairs")  # examples_for("xl430-biped") is EXAMPLES
 
 
+@pytest.mark.slow
 @pytest.mark.xdist_group("stairs-xl430")
 def test_stairs_up_and_down_are_one_walk(stairs_walk):
     course, walk, _ = stairs_walk
@@ -218,6 +225,7 @@ def test_stairs_up_and_down_are_one_walk(stairs_walk):
     assert walk.trajectory.root_m[-1, 0] == pytest.approx(walk.steps[-1].foothold_m + rb.geometry.heel_back, abs=1e-6)
 
 
+@pytest.mark.slow
 @pytest.mark.xdist_group("stairs-xl430")
 def test_flat_steps_are_the_boulic_walkers(stairs_walk):
     _, walk, _ = stairs_walk
@@ -228,6 +236,7 @@ def test_flat_steps_are_the_boulic_walkers(stairs_walk):
     assert inner.count("StepSegment") == len(flat)
 
 
+@pytest.mark.slow
 @pytest.mark.xdist_group("stairs-xl430")
 def test_grid_search_beats_the_middle_and_nears_brute_force(stairs_walk):
     _, walk, _ = stairs_walk

@@ -91,6 +91,7 @@ def test_mass_model_matches_mujoco():
         assert np.abs(tau[:6] - robot.data.qfrc_bias[dofs]).max() < 1e-9
 
 
+@pytest.mark.slow
 def test_op3_walks_2_m_free_floating_within_the_targets(capsys):
     code, r = sim(capsys, "--robot", "op3", "--distance", "2")
     assert code == 0 and r["support"] == "free"
@@ -118,6 +119,7 @@ def test_op3_walks_at_0_2_m_per_s(capsys):
     assert r["distance_planned_m"] / r["simulated_s"] > 0.13  # 2 m in ~14 s, standing still included
 
 
+@pytest.mark.slow
 def test_a_sideways_push_mid_step_is_survived(capsys):
     code, r = sim(capsys, "--robot", "op3", "--distance", "1", "--push", "0.7")
     assert code == 0 and r["fell"] is False
@@ -152,6 +154,7 @@ def test_a_pitch_only_robot_free_standing_is_refused_and_would_fall_sideways(tmp
     assert 0.5 < row["fell_at_s"] < 4.0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(TODAY_BOOM_M))
 def test_the_boom_reproduces_todays_figures_within_2_percent(name, capsys):
     code, r = sim(capsys, "--robot", name, "--distance", "1.0", "--boom")

@@ -34,6 +34,7 @@ def sim(capsys, *args: str) -> tuple[int, dict]:
     return code, json.loads(capsys.readouterr().out)
 
 
+@pytest.mark.slow
 def test_bioloid_walks_2_m_free_floating_within_the_targets(capsys):
     code, r = sim(capsys, "--distance", "2")
     assert code == 0 and r["support"] == "free"

@@ -29,7 +29,7 @@ from gaitbot.robot.calibration import tick_limits
 from gaitbot.robot.config import load_robot_config
 from gaitbot.servos.models import SERVO_MODELS
 from gaitbot.robot.gains import gain_writes
-from helpers import CONFIG_DIR, crc16, emulator_for, gaitbot, parse_packet  # noqa: E402 - the independent decoder
+from helpers import CONFIG_DIR, crc16, emulator_for, gaitbot, parse_packet, slow_except  # noqa: E402 - the independent decoder
 
 WRITE = 0x03
 XM, AX, STS = SERVO_MODELS["XM430-W350"], SERVO_MODELS["AX-12A"], SERVO_MODELS["STS3215"]
@@ -214,7 +214,7 @@ def test_the_limit_guard_passes_settings_on():
 
 # --- a real pty: the emulator keeps what it was sent ----------------------------------------------
 
-@pytest.mark.parametrize("name", sorted(EXPECTED))
+@pytest.mark.parametrize("name", slow_except(sorted(EXPECTED)))
 def test_the_emulator_receives_the_gain_registers(name, tmp_path):
     _, _, gains = EXPECTED[name]
     config = load_robot_config(CONFIG_DIR / f"{name}.toml")
