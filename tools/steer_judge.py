@@ -8,7 +8,10 @@ a swing foot above the other counts as touching). docs/steering.md shows the tab
 test_steer_physics.py checks the bars (no fall, pose within 15% of the plan, plan within 25% of the command,
 soles >= 5 mm apart).
 
-    python tools/steer_judge.py [--robot op3] [--goals] [WALK ...]
+    python tools/steer_judge.py [--robot op3] [--goals] [WALK ...] [--markdown]
+
+With ``--markdown`` the table is printed as the docs' figure block (docs/figures.md): ``steer-judge``, or
+``steer-judge-goals`` with ``--goals``.
 """
 
 from __future__ import annotations
@@ -177,11 +180,16 @@ def main(argv=None) -> int:
     p.add_argument("walks", nargs="*", help=f"walks to judge (default all: {', '.join(WALKS)})")
     p.add_argument("--robot", default="op3")
     p.add_argument("--goals", action="store_true", help="play the goals (sag feedforward) instead of the planned angles")
+    p.add_argument("--markdown", action="store_true", help="print the table as the docs' figure block")
     args = p.parse_args(argv)
+    if args.markdown:
+        print(f"<!-- figure steer-judge{'-goals' if args.goals else ''} -->")
     print("| walk | commanded (x m, y m, heading deg) | planned | Menagerie OP3 | fell | least sole gap mm |")
     print("|---|---|---|---|---|---|")
     for name in args.walks or list(WALKS):
         print(row(judge(args.robot, name, args.goals)), flush=True)
+    if args.markdown:
+        print("<!-- /figure -->")
     return 0
 
 

@@ -8,7 +8,10 @@ place (a still command), then a stop. Fixed seed: the same walk on any machine. 
 ``gaitbot walk --sim`` sends them. Prints, per robot: commands, steps, simulated time, fell (and when),
 and the planned and simulated end poses.
 
-    python tools/steer_random.py [--minutes M] [--seed S] [--robot op3 --robot bioloid]
+    python tools/steer_random.py [--minutes M] [--seed S] [--robot op3 --robot bioloid] [--markdown]
+
+With ``--markdown`` the lines are printed as the docs' figure block ``steer-random`` (docs/figures.md), without
+the planning time (a timing, not a figure).
 """
 
 from __future__ import annotations
@@ -47,7 +50,7 @@ def random_commands(limits, step_s: float, minutes: float, seed: int):
     return out
 
 
-def run(robot: str, minutes: float, seed: int) -> str:
+def run(robot: str, minutes: float, seed: int, timed: bool = True) -> str:
     from gaitbot.app.options import load_robot
     from gaitbot.gait.steer.schedule import CommandSchedule
     from gaitbot.robot.balanced_walk import balanced_gait_settings
@@ -62,7 +65,7 @@ def run(robot: str, minutes: float, seed: int) -> str:
     planned_s = time.perf_counter() - start
     planned, actual, fell = steer_judge.play_plan_own(robot, plan)
     return (f"{robot}: {len(commands) - 1} commands over {commands[-1].t_s:.0f} s, {len(steps)} steps, "
-            f"{plan.walk.t_s[-1]:.0f} s walked (planned in {planned_s:.1f} s); fell: {'YES' if fell else 'no'}; "
+            f"{plan.walk.t_s[-1]:.0f} s walked{f' (planned in {planned_s:.1f} s)' if timed else ''}; fell: {'YES' if fell else 'no'}; "
             f"end pose planned ({planned[0]:.2f} m, {planned[1]:.2f} m, {planned[2]:.0f} deg), simulated "
             f"({actual[0]:.2f} m, {actual[1]:.2f} m, {actual[2]:.0f} deg)")
 
@@ -72,9 +75,14 @@ def main(argv=None) -> int:
     p.add_argument("--minutes", type=float, default=10.0)
     p.add_argument("--seed", type=int, default=22)
     p.add_argument("--robot", action="append")
+    p.add_argument("--markdown", action="store_true", help="print the lines as the docs' figure block")
     args = p.parse_args(argv)
+    if args.markdown:
+        print("<!-- figure steer-random -->\n```text")
     for robot in args.robot or ["op3", "bioloid"]:
-        print(run(robot, args.minutes, args.seed), flush=True)
+        print(run(robot, args.minutes, args.seed, timed=not args.markdown), flush=True)
+    if args.markdown:
+        print("```\n<!-- /figure -->")
     return 0
 
 

@@ -9,6 +9,11 @@ the angles the walker computed for the same frames: the largest angle error per 
 the peak velocity and acceleration of the step (as a share of the joint's limit) predicted over sent
 (their range over the steps: the check's PREDICTION_SLACK must cover the largest). Then the CPU time of each
 of the check's stages (one a frame), p50 and p99.
+
+    python tools/step_check_accuracy.py --minutes 2 --seed 5 --markdown
+
+prints the docs' figure block ``step-check-accuracy`` (docs/driving.md): the same table without the CPU times
+(a timing is not a checked figure, docs/figures.md).
 """
 
 from __future__ import annotations
@@ -109,17 +114,26 @@ def main() -> None:
     parser.add_argument("--robot", action="append", help="robot config (repeatable; default op3 and bioloid)")
     parser.add_argument("--minutes", type=float, default=2.0)
     parser.add_argument("--seed", type=int, default=5)
+    parser.add_argument("--markdown", action="store_true", help="the table without the CPU times, as the docs' "
+                        "figure block step-check-accuracy")
     args = parser.parse_args()
-    print("| robot | steps | angle error p50 / p99 / max deg | peak velocity predicted / sent | peak acceleration "
-          "predicted / sent | preview p50 / p99 ms | balance p50 / p99 ms | limits p50 / p99 ms |")
-    print("|---|---|---|---|---|---|---|---|")
+    columns = ("| robot | steps | angle error p50 / p99 / max deg | peak velocity predicted / sent | peak acceleration "
+               "predicted / sent |")
+    if args.markdown:
+        print("<!-- figure step-check-accuracy -->\n" + columns + "\n|---|---|---|---|---|")
+    else:
+        print(columns + " preview p50 / p99 ms | balance p50 / p99 ms | limits p50 / p99 ms |")
+        print("|---|---|---|---|---|---|---|---|")
     for robot in args.robot or ["op3", "bioloid"]:
         r = measure(robot, args.minutes, args.seed)
         e, c = r["error_deg"], r["costs_ms"]
-        print(f"| {robot} | {r['steps']} | {e[0]:.1f} / {e[1]:.1f} / {e[2]:.1f} | {r['velocity'][0]:.2f} to "
-              f"{r['velocity'][1]:.2f} | {r['accel'][0]:.2f} to {r['accel'][1]:.2f} | "
-              + " | ".join(f"{c[k][0]:.2f} / {c[k][1]:.2f}" for k in ("preview", "balance", "limits")) + " |",
-              flush=True)
+        row = (f"| {robot} | {r['steps']} | {e[0]:.1f} / {e[1]:.1f} / {e[2]:.1f} | {r['velocity'][0]:.2f} to "
+               f"{r['velocity'][1]:.2f} | {r['accel'][0]:.2f} to {r['accel'][1]:.2f} |")
+        if not args.markdown:
+            row += " " + " | ".join(f"{c[k][0]:.2f} / {c[k][1]:.2f}" for k in ("preview", "balance", "limits")) + " |"
+        print(row, flush=True)
+    if args.markdown:
+        print("<!-- /figure -->")
 
 
 if __name__ == "__main__":

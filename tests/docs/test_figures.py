@@ -70,8 +70,10 @@ def test_every_picture_in_the_docs_is_drawn_by_figures_py():
 def _simulates(script: str) -> bool:
     """A figure script that runs MuJoCo: it imports gaitbot.sim, mujoco, or a script that does, or walks --sim."""
     text = (REPO_ROOT / script).read_text()
-    return bool(re.search(r"^\s*(from|import) (gaitbot\.sim|mujoco|op3_menagerie)\b|import_mujoco|\"--sim\"",
-                          text, re.M))
+    if re.search(r"^\s*(from|import) (gaitbot\.sim|mujoco|op3_menagerie)\b|import_mujoco|\"--sim\"", text, re.M):
+        return True
+    tools = {m for m in re.findall(r"^\s*import (\w+)", text, re.M) if (REPO_ROOT / "tools" / f"{m}.py").is_file()}
+    return any(_simulates(f"tools/{m}.py") for m in tools if f"tools/{m}.py" != script)
 
 
 @pytest.mark.parametrize("region", REGIONS, ids=lambda r: r.name)
