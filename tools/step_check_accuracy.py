@@ -61,7 +61,10 @@ def measure(robot: str, minutes: float, seed: int) -> dict:
         costs["limits"].append(time.process_time() - start)
         if out is None:
             q, skip = self.predicted_angles(walker, arrays, first, end, foothold)
-            predicted[(id(walker), len(walker.plan_arrays()["zmp"]))] = (q[skip:], self)
+            # the step's first frame, counted from the walk's start (the online walker drops frames far
+            # behind its output: plan_arrays starts at plan_start_frame)
+            first_frame = walker.plan_start_frame + len(walker.plan_arrays()["zmp"])
+            predicted[(id(walker), first_frame)] = (q[skip:], self)
         return out
 
     check._balance, check._limits = timed("balance"), limits
