@@ -126,3 +126,15 @@ def test_nothing_felt_walks_the_plan_and_a_felt_push_left_moves_a_foothold_left(
     for _, step in leaning_left.log.moved:
         assert step.moved_m[1] >= 0.0 and step.error_m[1] > 0
     assert any(step.moved_m[1] > 0.01 for _, step in leaning_left.log.moved)
+
+
+@pytest.mark.parametrize("argv, words", [
+    (("drive", "--robot", "op3", "--sim", "--feedback", "step"), "--feedback step: the live drive"),
+    (("walk", "--robot", "op3", "--dry-run", "--feedback", "step", "--velocity", "0.05,0,0", "--duration", "2"),
+     "--feedback step: only a balanced walk"),
+])
+def test_stepping_where_it_cannot_move_footholds_is_refused_in_one_line(capsys, argv, words):
+    from helpers import run_cli
+
+    code, out, err = run_cli(capsys, *argv)
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1 and out == ""
