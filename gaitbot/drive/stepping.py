@@ -2,8 +2,8 @@
 
 ``--feedback step`` (gaitbot.app.walk): the planned walk's steps are fed one at a time to an online
 BalancedWalker (the drive's walker, with the plan's own speed-fitted settings, so that unpushed it walks the
-plan's frames), each appended DECIDE_FRAMES frames before its double support starts: late, so that the decision sees
-a recent estimate, early enough for the walker's preview to see the step coming. At that moment gaitbot.feel.capture compares the measured
+plan's frames), each appended DECIDE_FRAMES frames before its double support starts: about when the step before it starts,
+as the live drive queues its steps, early enough for the walker's preview to see the step coming. At that moment gaitbot.feel.capture compares the measured
 DCM with the plan's; if it left what the ankles hold, the step's foothold moves toward it (within ``[steer]``
 limits and the soles' gap). The steps after a moved one keep their planned length from the foot they follow
 and their side's distance from it. Every goal then goes through the session's Feedback, which keeps it
@@ -24,13 +24,12 @@ from gaitbot.gait.body import SIDE_SIGN
 from gaitbot.gait.joints import LEG_JOINTS
 from gaitbot.robot.balanced_walk import leg_limits_rad, servo_stiffness_nm_per_rad
 
-DECIDE_FRAMES = 12
-"""A step is appended (and its foothold decided) this many frames before its double support starts: 0.2 s at
-60 Hz, half a step of the op3's 0.8 s cycle. Later (2 frames) answers a push sooner but the walker's preview
-then sees the step too late (the frames leave the plan's by ~20 ticks unpushed, and more pushes fell); a whole
-step ahead (24) answers a push in the step after next (both measured: docs/feedback.md)."""
-
-
+DECIDE_FRAMES = 24
+"""A step is appended (and its foothold decided) this many frames before its double support starts: 0.4 s at
+60 Hz, one step of the op3's 0.8 s cycle, as the live drive keeps one step queued. Later (12 or 2 frames)
+answers a push sooner, but the walker's preview then sees the step late: unpushed, the frames leave the
+plan's by up to 20 ticks (3 at 24), and pushes that the planned walk survives fell (measured with
+python tools/push_survival.py --modes step; docs/feedback.md)."""
 CHECK_TRIES = 3
 """A moved step refused by the step check is tried at half the move, then at a quarter; then the plan's."""
 

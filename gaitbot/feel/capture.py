@@ -13,8 +13,11 @@ simulation). While |xi_error| is inside what the ankles can hold (HOLD_SHARE of 
 half width: the ZMP can move that far from its planned point), nothing changes. Beyond it, the next foothold
 (a step not yet started) moves by STEP_GAIN x xi_error (xi keeps diverging until that foot lands), the move
 clipped per axis to the robot's ``[steer]`` per-step limits (forward, backward, sideways), the foot never
-further behind the stance foot than max_backward_m, its lateral move inward limited by the soles' gap over
-the whole swing (gaitbot.gait.steer.soles: at least min_gap_m; a foot never crosses over). The caller then
+further behind the stance foot than max_backward_m, and never inward: toward the stance foot there is only
+the soles' gap's slack (7 mm on the op3: the soles stand 17 mm apart, min_gap_m is 10), and those small
+inward moves were measured to make more pushes fall, not fewer (the lateral sway they add grows from step to
+step); a push toward the stance foot is caught by the next step, the other foot's, outward. The soles' gap
+over the whole swing (gaitbot.gait.steer.soles) is measured and kept at least min_gap_m. The caller then
 checks the moved step as the drive checks every step (gaitbot.drive.step_check: reach, joint limits, ZMP).
 A robot without ``[steer]`` does not step.
 """
@@ -37,8 +40,6 @@ hold the DCM's error in: the ZMP planned near the sole's middle can move that fa
 STEP_GAIN = 1.0
 """The foothold moves by this multiple of the DCM's error when it was felt (0.6, 1.0 and 1.5 measured alike
 on the pushes that fell: python tools/push_survival.py --modes step; docs/feedback.md)."""
-GAP_BISECTIONS = 12
-"""Halvings of an inward move until the soles keep their gap (under 0.1 mm of a 4 cm move)."""
 
 
 @dataclass(frozen=True)
@@ -93,8 +94,8 @@ class CapturePoint:
         ahead = c * px + s * py
         fx = max(ahead + fx, min(-lim.max_backward_m, ahead)) - ahead
         outward = 1.0 if planned.side == "left" else -1.0
-        if fy * outward < 0:  # inward, toward the stance foot: only as far as the soles keep their gap
-            fy = self._inward(stance, swing_from, planned, fx, fy)
+        if fy * outward < 0:  # inward, toward the stance foot: not at all (INWARD, module docstring)
+            fy = 0.0
         moved = FootPlacement(planned.side, planned.x_m + c * fx - s * fy, planned.y_m + s * fx + c * fy,
                               planned.yaw_rad)
         gap = swept_gap_m(self.geometry, stance, swing_from, moved)
@@ -111,22 +112,3 @@ class CapturePoint:
         if gap < self.limits.min_gap_m:
             return CaptureStep(step.error_m, True, planned, (0.0, 0.0))
         return CaptureStep(step.error_m, True, moved, (dx, dy), gap)
-
-    def _inward(self, stance: FootPlacement, swing_from: FootPlacement, planned: FootPlacement,
-                fx: float, fy: float) -> float:
-        """The largest share of the inward move ``fy`` that keeps the soles' gap over the swing (bisection)."""
-        c, s = math.cos(stance.yaw_rad), math.sin(stance.yaw_rad)
-
-        def keeps(share: float) -> bool:
-            y = share * fy
-            foot = FootPlacement(planned.side, planned.x_m + c * fx - s * y, planned.y_m + s * fx + c * y,
-                                 planned.yaw_rad)
-            return swept_gap_m(self.geometry, stance, swing_from, foot) >= self.limits.min_gap_m
-
-        if keeps(1.0):
-            return fy
-        low, high = 0.0, 1.0
-        for _ in range(GAP_BISECTIONS):
-            mid = 0.5 * (low + high)
-            low, high = (mid, high) if keeps(mid) else (low, mid)
-        return low * fy
