@@ -45,8 +45,9 @@ class MovedStep:
 
 @dataclass
 class SteppingLog:
-    """The decisions taken: one CaptureStep per step that was moved (with when it was decided: s from the walk's start), and
-    how many wanted moves the step check refused (the plan's foothold kept)."""
+    """The decisions taken: one CaptureStep per step that was moved (with when it was decided: s from the walk's
+    start), and how many steps the error left the hold but nothing moved (inward only, or refused by the step
+    check: the plan's foothold kept)."""
 
     moved: list[tuple[float, CaptureStep]] = field(default_factory=list)
     steps: int = 0
@@ -90,23 +91,25 @@ class SteppingFrames:
         return self
 
     def __next__(self) -> np.ndarray:
-        self._append_due()
+        if not self._append_due():
+            self.walker.work()  # a share of the last append's replan, as the drive does (BalancedWalker.work)
         frame = self.walker.next_frame()
         if frame is None:
             raise StopIteration
         return self.config.calibration.angles_to_ticks(frame[2], LEG_JOINTS)
 
-    def _append_due(self) -> None:
-        """Append the next step when its double support is DECIDE_FRAMES away (or close the walk)."""
+    def _append_due(self) -> bool:
+        """Append the next step when its double support is DECIDE_FRAMES away (or close the walk); whether it did."""
         walker = self.walker
         if walker.finished:
-            return
+            return False
         if self._next >= len(self.steps):
             if walker._out + DECIDE_FRAMES >= self._start_frame():
                 walker.finish()
-            return
+                return True
+            return False
         if self.log.steps and walker._out + DECIDE_FRAMES < self._start_frame():
-            return
+            return False
         step = self.steps[self._next]
         self._next += 1
         self.log.steps += 1
@@ -123,7 +126,8 @@ class SteppingFrames:
                 planned = decision.foothold
             else:
                 self.log.refused += 1
-        walker.append_footstep(planned, step.length_m)
+        walker.append_footstep(planned, step.length_m, spread=True)
+        return True
 
     def _checked(self, decision: CaptureStep, stance, swing_from, planned, length_m: float) -> CaptureStep:
         """The move, or its half, that passes the drive's step check (reach, limits, ZMP, gap); else none."""
