@@ -5,6 +5,7 @@
     python tools/push_survival.py --robot bioloid --max-impulse 1.0
     python tools/push_survival.py --json             # one JSON object per push
     python tools/push_survival.py --markdown         # docs/feedback.md's figure: survived per quarter of the range
+    python tools/push_survival.py --modes step       # capture-point stepping (--feedback step)
 
 Each push is drawn from a seeded generator (--seed): an impulse uniform in 0..--max-impulse N s, a direction
 uniform in 0..360 deg (from forward, counter-clockwise), a phase uniform over the middle step (its share of
@@ -79,7 +80,8 @@ def markdown(args) -> str:
         rows.append(f"| {edges[q]:g} to {edges[q + 1]:g} | {counts[q, 0]} | "
                     + " | ".join(str(c) for c in counts[q, 1:]) + " |")
     rows.append(f"| all | {counts[:, 0].sum()} | " + " | ".join(str(c) for c in counts[:, 1:].sum(axis=0)) + " |")
-    return f"<!-- figure push-{args.robot} -->\n" + "\n".join(rows) + "\n<!-- /figure -->"
+    name = f"push-{args.robot}" + ("-step" if "step" in modes else "")
+    return f"<!-- figure {name} -->\n" + "\n".join(rows) + "\n<!-- /figure -->"
 
 
 def main_(argv=None) -> int:
@@ -88,7 +90,7 @@ def main_(argv=None) -> int:
     parser.add_argument("--pushes", type=int, default=100)
     parser.add_argument("--max-impulse", type=float, default=2.0)
     parser.add_argument("--seed", type=int, default=23)
-    parser.add_argument("--modes", default="none,full")
+    parser.add_argument("--modes", default="none,full", help="feedback modes, comma-separated: none, gyro, full, step")
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--markdown", action="store_true", help="print the docs' figure (tools/figures.py)")
     args = parser.parse_args(argv)

@@ -25,6 +25,7 @@ from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.recording import BusRecorder, RecordingFailed
 from gaitbot.check.preflight import LimitBroken, preflight  # noqa: F401 (LimitBroken: walk's refusal)
 from gaitbot.errors import UserError
+from gaitbot.robot.balanced_walk import BalancedPlan
 from gaitbot.robot.calibration import standing_ticks, trajectory_ticks
 from gaitbot.robot.calibration_file import sent_calibration
 from gaitbot.robot.gains import gain_notes, gain_writes
@@ -97,6 +98,7 @@ def run(args) -> int:
     check_rate_option(config, args.rate)
     feedback_choice(args, config)  # refused here, before any note (the open-loop note comes once all is checked)
     walk = planned_walk(args, config)
+    check_stepping(args, config, walk)
     report = preflight(config, walk.goals, on_boom=args.boom, planned=walk.planned)
     if not report.ok:
         raise LimitBroken(f"walk refused before anything moved: {report.first_error}")
@@ -133,13 +135,14 @@ def run(args) -> int:
                           SessionLimits(velocity, acceleration, 1.0 / walk.rate_hz), clock=clock,
                           torque_off_on_exit=config.bus.torque_off_on_exit, setup_writes=gain_writes(config),
                           health=health, feedback=feedback)
-    view = None
+    view = stepping = None
     try:
         view = open_view(args, config, walk.goals, walk.planned, health, not isinstance(clock, VirtualClock),
                          feedback, sim.robot if sim is not None else None)
         with progress("simulating" if sim is not None else "walking", total=len(frames), unit="frame") as bar:
             status = _status(bar, walk.heel_strikes, walk.rate_hz, health)
-            result = session.run(frames, view.chain(status) if view else status)
+            stepping = stepping_source(walk, config, feedback)
+            result = session.run(stepping or frames, view.chain(status) if view else status)
     finally:
         if recorder is not None:
             recorder.close()
@@ -147,7 +150,30 @@ def run(args) -> int:
             view.close()
     for note in bus.open_notes:
         print(f"note: {note}", file=sys.stderr)
+    if sim is not None and stepping is not None:
+        sim.extra["capture_steps"] = stepping.log.summary()
     return _report(args, config, walk, result, sim, port, clock, health, feedback)
+
+
+def check_stepping(args, config, walk) -> None:
+    """``--feedback step`` needs a balanced walk of planned steps (not a file or a steered walk) and the
+    robot's ``[steer]`` limits (how far a foothold may move); else one line, exit 2."""
+    if getattr(args, "feedback", None) != "step":
+        return
+    if config.steer is None:
+        raise UsageError(f"--feedback step: robot {config.name} has no [steer] limits (how far a step may move)")
+    if type(walk.plan) is not BalancedPlan:  # a steered walk's plan is another class: its steps are commands
+        raise UsageError("--feedback step: only a balanced walk of --steps or --distance moves its footholds")
+
+
+def stepping_source(walk, config, feedback):
+    """The frames of ``--feedback step``: the plan's steps walked online, the next foothold moved to catch a
+    push (gaitbot.drive.stepping); None for every other mode (the planned frames as they are)."""
+    if feedback is None or feedback.mode != "step":
+        return None
+    from gaitbot.drive.stepping import SteppingFrames
+
+    return SteppingFrames(config, walk.plan, feedback.estimate, lambda: feedback.active)
 
 
 def _recorder(args, config, clock, rate_hz: float) -> BusRecorder | None:

@@ -1,0 +1,160 @@
+"""A planned balanced walk walked online, its next foothold moved when the IMU says a push needs a step.
+
+``--feedback step`` (gaitbot.app.walk): the planned walk's steps are fed one at a time to an online
+BalancedWalker (the drive's walker, with the plan's own speed-fitted settings, so that unpushed it walks the
+plan's frames), each appended DECIDE_FRAMES frames before its double support starts: about when the step before it starts,
+as the live drive queues its steps, early enough for the walker's preview to see the step coming. At that moment gaitbot.feel.capture compares the measured
+DCM with the plan's; if it left what the ankles hold, the step's foothold moves toward it (within ``[steer]``
+limits and the soles' gap). The steps after a moved one keep their planned length from the foot they follow
+and their side's distance from it. Every goal then goes through the session's Feedback, which keeps it
+inside every joint's position, velocity and acceleration limits (``gaitbot check`` holds it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gaitbot.drive.step_check import StepCheck
+from gaitbot.feel.capture import CapturePoint, CaptureStep, dcm_error_m
+from gaitbot.gait.balance.walker import BalancedWalker
+from gaitbot.gait.balance.zmp_reference import FootPlacement
+from gaitbot.gait.body import SIDE_SIGN
+from gaitbot.gait.joints import LEG_JOINTS
+from gaitbot.robot.balanced_walk import leg_limits_rad, servo_stiffness_nm_per_rad
+
+DECIDE_FRAMES = 24
+"""A step is appended (and its foothold decided) this many frames before its double support starts: 0.4 s at
+60 Hz, one step of the op3's 0.8 s cycle, as the live drive keeps one step queued. Later (12 or 2 frames)
+answers a push sooner, but the walker's preview then sees the step late: unpushed, the frames leave the
+plan's by up to 20 ticks (3 at 24), and pushes that the planned walk survives fell (measured with
+python tools/push_survival.py --modes step; docs/feedback.md)."""
+CHECK_TRIES = 3
+"""A moved step refused by the step check is tried at half the move, then at a quarter; then the plan's."""
+
+
+@dataclass(frozen=True)
+class MovedStep:
+    """A moved step in the terms the step check reads (gaitbot.drive.step_check)."""
+
+    foothold: FootPlacement
+    length_m: float
+    gap_m: float
+
+
+@dataclass
+class SteppingLog:
+    """The decisions taken: one CaptureStep per step that was moved (with when it was decided: s from the walk's
+    start), and how many steps the error left the hold but nothing moved (inward only, or refused by the step
+    check: the plan's foothold kept)."""
+
+    moved: list[tuple[float, CaptureStep]] = field(default_factory=list)
+    steps: int = 0
+    refused: int = 0
+
+    def summary(self) -> list[dict]:
+        """The moved steps for ``--json``: when decided (s of the walk), the DCM's error and the move (m)."""
+        return [{"decided_s": round(t_s, 4), "side": c.foothold.side,
+                 "dcm_error_m": [round(v, 4) for v in c.error_m], "moved_m": [round(v, 4) for v in c.moved_m]}
+                for t_s, c in self.moved]
+
+
+class SteppingFrames:
+    """An iterator of tick frames: the plan's steps walked online with capture steps (module docstring).
+    ``plan``: a gaitbot.robot.balanced_walk.BalancedPlan; ``estimate``: anything with roll_deg, pitch_deg,
+    rates_dps and started (gaitbot.feel.estimate.TiltEstimate, the session's Feedback's); ``active``: a
+    callable saying whether the IMU may be trusted (a faulty IMU walks the plan's footholds)."""
+
+    def __init__(self, config, plan, estimate, active=lambda: True) -> None:
+        if config.steer is None:
+            raise ValueError(f"robot {config.name} has no [steer] limits: it cannot step to catch a push")
+        self.config, self.estimate, self.active = config, estimate, active
+        fit = plan.fit
+        self.walker = BalancedWalker(config.body, fit.gait, fit.balance, limits_rad=leg_limits_rad(config),
+                                     kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
+        self.steps = [s for s in plan.planned_steps if not s.closing]
+        if self.steps and self.steps[0].leg != self.walker.next_swing_side:
+            self.walker.lead_with(self.steps[0].leg)
+        self.capture = CapturePoint(config.body.geometry, config.steer)
+        self.step_check = StepCheck(config, 1.0 / self.walker.rate_hz)
+        self.rate_hz = self.walker.rate_hz
+        self.log = SteppingLog()
+        self._next = 0
+        self._frames = len(plan.walk.t_s)
+        self._append_due()  # the first step: before the walk starts, as the plan has it
+
+    def __len__(self) -> int:
+        return self._frames
+
+    def __iter__(self):
+        return self
+
+    def __next__(self) -> np.ndarray:
+        if not self._append_due():
+            self.walker.work()  # a share of the last append's replan, as the drive does (BalancedWalker.work)
+        frame = self.walker.next_frame()
+        if frame is None:
+            raise StopIteration
+        return self.config.calibration.angles_to_ticks(frame[2], LEG_JOINTS)
+
+    def _append_due(self) -> bool:
+        """Append the next step when its double support is DECIDE_FRAMES away (or close the walk); whether it did."""
+        walker = self.walker
+        if walker.finished:
+            return False
+        if self._next >= len(self.steps):
+            if walker._out + DECIDE_FRAMES >= self._start_frame():
+                walker.finish()
+                return True
+            return False
+        if self.log.steps and walker._out + DECIDE_FRAMES < self._start_frame():
+            return False
+        step = self.steps[self._next]
+        self._next += 1
+        self.log.steps += 1
+        stance_side = "left" if step.leg == "right" else "right"
+        feet = walker.feet
+        stance, swing_from = feet[stance_side], feet[step.leg]
+        planned = FootPlacement(step.leg, stance.x_m + step.length_m,
+                                stance.y_m + SIDE_SIGN[step.leg] * self.config.body.geometry.hip_width_m, 0.0)
+        decision = self._decide(stance, swing_from, planned)
+        if decision is not None and decision.beyond:
+            decision = self._checked(decision, stance, swing_from, planned, step.length_m)
+            if decision.moved_m != (0.0, 0.0):
+                self.log.moved.append((walker._out / self.rate_hz, decision))
+                planned = decision.foothold
+            else:
+                self.log.refused += 1
+        walker.append_footstep(planned, step.length_m, spread=True)
+        return True
+
+    def _checked(self, decision: CaptureStep, stance, swing_from, planned, length_m: float) -> CaptureStep:
+        """The move, or its half, that passes the drive's step check (reach, limits, ZMP, gap); else none."""
+        for _ in range(CHECK_TRIES):
+            if decision.moved_m == (0.0, 0.0):
+                return decision
+            step = MovedStep(decision.foothold, length_m, decision.gap_m)
+            try:
+                reason = self.step_check.check(self.walker, step)
+            except (ValueError, ArithmeticError) as exc:  # beyond the swing's shapes or the leg's reach
+                reason = str(exc)
+            if reason is None:
+                return decision
+            decision = self.capture.halved(decision, stance, swing_from, planned)
+        return CaptureStep(decision.error_m, True, planned, (0.0, 0.0))
+
+    def _start_frame(self) -> int:
+        """The walk frame where the next step's double support starts: the last planned step's landing."""
+        walker = self.walker
+        if not walker.planned_steps:
+            return 0
+        return round(walker.planned_steps[-1].end_s * self.rate_hz)
+
+    def _decide(self, stance, swing_from, planned) -> CaptureStep | None:
+        e = self.estimate
+        if not (self.active() and e.started):
+            return None
+        error = dcm_error_m(e.roll_deg, e.pitch_deg, float(e.rates_dps[0]), float(e.rates_dps[1]),
+                            self.walker.com_height_m)
+        return self.capture.decide(error, stance, swing_from, planned)
