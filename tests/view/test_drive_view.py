@@ -126,7 +126,7 @@ async def steer(url: str, twist_s: float) -> dict:
 @pytest.mark.slow
 def test_a_foxglove_client_watches_and_steers_a_simulated_drive():
     process = subprocess.Popen([sys.executable, "-m", "gaitbot.app.cli", "drive", "--robot", "op3", "--sim", "--foxglove",
-                                "127.0.0.1:0", "--max-time", "9", "--json"], stdout=subprocess.PIPE,
+                                "127.0.0.1:0", "--max-time", "20", "--json"], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, cwd=REPO_ROOT)
     try:
         line = process.stderr.readline()
