@@ -9,11 +9,12 @@ tools/op3_menagerie.py into a temporary folder):
 
 - feel-menagerie: the issue's walks (2 m at 0.2 m/s; 1 m at 0.1 m/s, alone and with a push of 1.0 and 1.5 N s
   sideways and 1.5 N s forwards in its middle) with each feedback level;
-- feel-why: why the 0.2 m/s walk fell on this model, one thing changed at a time: the model's servos at the
-  stiffness gaitbot writes (kp = 4.1 N m over 6 deg, its 5 N m force limit kept), its joint damping (the
-  XM430's back-EMF, 1.084 N m s/rad) cut to 0.3, the sag feedforward computed for the model's own kp; then the
-  feedback's attitude term, which carries the soft model (per IMU seed) but makes gaitbot's own, stiffer
-  model drift or fall: why the op3 ships without it.
+- feel-why: why the 0.2 m/s walk fell on this model open loop, one thing changed at a time: the model's
+  servos at the stiffness gaitbot writes (kp = 4.1 N m over 6 deg, its 5 N m force limit kept), its joint
+  damping (the XM430's back-EMF, 1.084 N m s/rad) cut to 0.3, the sag feedforward computed for the model's
+  own kp; then the feedback's roll attitude term, which carries soft servos (this model per IMU seed, and
+  gaitbot's own model at factory gains) but makes gaitbot's own model at the stiffness it writes drift or
+  fall: why config/op3.toml gives it by the servos' stiffness.
 
 The simulation is deterministic on one machine; another CPU or MuJoCo release moves the figures within the
 simulated figures' tolerance (docs/figures.md, "Simulated figures").
@@ -50,11 +51,11 @@ WALKS = (
     ("the same `--push 1.5@0` (forwards)", (*SLOW, "--push", "1.5@0")),
 )
 MODES = ("none", "gyro", "full")
-#: The attitude terms tried on the soft model (docs/feedback.md, "The OP3's gains").
-ROLL = {"attitude_roll_gain": "0.3"}
-BOTH_AXES = {"attitude_roll_gain": "0.5", "attitude_pitch_gain": "0.5", "max_correction_deg": "12.0"}
+#: The attitude terms tried (docs/feedback.md, "The OP3's gains"): a roll gain whatever the servos' stiffness.
+FLAT_ROLL = {"attitude_roll_gain_by_servo_error": "[[6.0, 0.5]]"}
+QUIET_ROLL = {"attitude_roll_gain_by_servo_error": "[[6.0, 0.3]]"}
+FACTORY, HALF_WAY = {"full_torque_error_deg": "12.4"}, {"full_torque_error_deg": "8.0"}  # XM430: factory gain 800
 QUIET_IMU = {"gyro_noise_dps": "0.0", "gyro_bias_dps": "0.0", "acc_noise_g": "0.0"}
-OWN_WALK = ("--distance", "1", "--cycle", "0.8", "--max-step", "0.06")  # tools/push_survival.py's op3 walk
 XM430_STALL_NM, WRITTEN_ERROR_DEG = 4.1, 6.0  # config/op3.toml: the XM430-W350's stall torque, [servo] written
 
 
@@ -108,16 +109,15 @@ def measure() -> dict:
         their_error_deg = math.degrees(XM430_STALL_NM / 21.1)  # the model's kp, in the config's terms
         soft = config_variant(folder, "soft", full_torque_error_deg=f"{their_error_deg:.2f}")
         runs["why", "soft"] = sim("--robot", soft, "--sim-model", model, "--sim-map", MAP, *FAST, "--feedback", "none")
-        roll = config_variant(folder, "roll", **ROLL)
-        for seed in (0, 1, 2):
-            runs["why", f"roll {seed}"] = sim("--robot", roll, "--sim-model", model, "--sim-map", MAP, *FAST,
-                                              "--imu-seed", str(seed))
-        both = config_variant(folder, "both-axes", **BOTH_AXES)
-        runs["why", "both"] = sim("--robot", both, "--sim-model", model, "--sim-map", MAP, *FAST)
+        for seed in (1, 2):
+            runs["why", f"seed {seed}"] = sim(*on, *FAST, "--imu-seed", str(seed))
         runs["why", "own"] = sim("--robot", "op3", *FAST)
-        runs["why", "roll own"] = sim("--robot", roll, *FAST)
-        runs["why", "roll own quiet"] = sim("--robot", config_variant(folder, "roll-quiet", **ROLL, **QUIET_IMU), *FAST)
-        runs["why", "both own"] = sim("--robot", both, *OWN_WALK)
+        runs["why", "flat own"] = sim("--robot", config_variant(folder, "flat", **FLAT_ROLL), *FAST)
+        runs["why", "quiet own"] = sim("--robot", config_variant(folder, "quiet", **QUIET_ROLL, **QUIET_IMU), *FAST)
+        factory = config_variant(folder, "factory", **FACTORY)
+        runs["why", "factory gyro"] = sim("--robot", factory, *FAST, "--feedback", "gyro")
+        runs["why", "factory"] = sim("--robot", factory, *FAST)
+        runs["why", "half way"] = sim("--robot", config_variant(folder, "half-way", **HALF_WAY), *FAST)
     return runs
 
 
@@ -147,16 +147,16 @@ def why_table(runs: dict) -> str:
         ("its joint damping 0.3 instead of 1.084, feedback none", runs["why", "damping"]),
         (f"the sag feedforward for the model's kp (`full_torque_error_deg = {their_error_deg:.2f}`), feedback none",
          runs["why", "soft"]),
-        ("feedback full as shipped (gyro damping, no attitude term)", runs[FAST_LABEL, "full"]),
-        *((f"feedback full with `attitude_roll_gain = 0.3`, `--imu-seed {seed}`", runs["why", f"roll {seed}"])
-          for seed in (0, 1, 2)),
-        ("feedback full with the attitude in both axes (`attitude_roll_gain = attitude_pitch_gain = 0.5`, "
-         "`max_correction_deg = 12`)", runs["why", "both"]),
-        (f"{own}, feedback full as shipped", runs["why", "own"]),
-        (f"{own}, `attitude_roll_gain = 0.3`", runs["why", "roll own"]),
-        (f"{own}, `attitude_roll_gain = 0.3`, an IMU without noise or bias", runs["why", "roll own quiet"]),
-        (f"{own}, the attitude in both axes, at 0.15 m/s (`--distance 1 --cycle 0.8 --max-step 0.06`)",
-         runs["why", "both own"]),
+        ("feedback gyro (gyro damping alone)", runs[FAST_LABEL, "gyro"]),
+        ("feedback full as shipped (and the roll attitude, 0.5 for these servos), `--imu-seed 0`",
+         runs[FAST_LABEL, "full"]),
+        *((f"the same, `--imu-seed {seed}`", runs["why", f"seed {seed}"]) for seed in (1, 2)),
+        (f"{own} (servos at 6 deg), feedback full as shipped (no roll attitude at that stiffness)", runs["why", "own"]),
+        (f"{own}, a roll gain of 0.5 whatever the stiffness (`{FLAT_ROLL_TEXT}`)", runs["why", "flat own"]),
+        (f"{own}, a flat roll gain of 0.3, an IMU without noise or bias", runs["why", "quiet own"]),
+        (f"{own} at the XM430's factory gain (`full_torque_error_deg = 12.4`), feedback gyro", runs["why", "factory gyro"]),
+        (f"{own} at the factory gain, feedback full as shipped (roll attitude 0.5)", runs["why", "factory"]),
+        (f"{own} at 8 deg, feedback full as shipped (roll attitude 0.25)", runs["why", "half way"]),
     ]
     rows = ["| what changed (the 0.2 m/s walk, `--distance 2 --max-step 0.08 --cycle 0.8`, on Menagerie's OP3 unless "
             "said) | outcome | max torque / force limit | max tracking error deg |", "|---|---|---|---|"]
@@ -168,6 +168,7 @@ def why_table(runs: dict) -> str:
 
 
 FAST_LABEL = WALKS[0][0]
+FLAT_ROLL_TEXT = f"attitude_roll_gain_by_servo_error = {FLAT_ROLL['attitude_roll_gain_by_servo_error']}"
 
 
 def main(argv=None) -> int:

@@ -165,7 +165,7 @@ def _drive(args, config, source, commands_out, mode: str, view=None) -> int:
         raise UsageError(f"--record {args.record}: cannot write the recording ({exc.strerror or exc})") from None
     velocity, acceleration = joint_limits_ticks(config)
     health = HealthMonitor.for_robot(config, _say, clock.now)
-    feedback = make_feedback(config, mode, bus, clock, frames.period_s)
+    feedback = make_feedback(config, mode, bus, clock, frames.period_s, sim)
     try:
         with GracefulSignals(frames) as signals:
             result = walk_session(bus, config.ids, frames, standing_ticks(config), max_velocity_ticks_per_s=velocity,

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+import numpy as np
+
 from gaitbot.app.options import UsageError
 
 FEEDBACK_CHOICES = ("none", "gyro", "full", "step")
@@ -36,8 +38,10 @@ def feedback_mode(args, config) -> str:
     return mode
 
 
-def make_feedback(config, mode: str, bus, clock, period_s: float):
-    """The Feedback of a walk (None open loop without an IMU); its IMU faults are said once, on stderr."""
+def make_feedback(config, mode: str, bus, clock, period_s: float, sim=None):
+    """The Feedback of a walk (None open loop without an IMU); its IMU faults are said once, on stderr.
+    ``sim``: the simulated walk; on another author's model the feedback is told its servos' own stiffness
+    (gains written to that model are not simulated: docs/simulation.md)."""
     if not config.imu.present:
         return None
     from gaitbot.feel.feedback import Feedback
@@ -47,7 +51,19 @@ def make_feedback(config, mode: str, bus, clock, period_s: float):
         print(f"\nwarning: {text}" if sys.stderr.isatty() else f"warning: {text}", file=sys.stderr, flush=True)
 
     reader = ImuReader(bus, config.imu, clock.now, period_s, on_fault=warn)
-    return Feedback(config, mode, reader, period_s, clock.now)
+    servo_error_deg = foreign_servo_error_deg(sim)
+    if servo_error_deg is not None and mode not in ("none", "gyro") and config.imu.attitude_roll_gain_by_servo_error:
+        print(f"note: --sim-model: feedback for its servos (full torque at {servo_error_deg:.1f} deg of error): roll "
+              f"attitude gain {config.imu.roll_gain(servo_error_deg):g}", file=sys.stderr)
+    return Feedback(config, mode, reader, period_s, clock.now, servo_error_deg)
+
+
+def foreign_servo_error_deg(sim) -> float | None:
+    """The mean full-torque error (deg) of another author's model's mapped servos, or None on gaitbot's own."""
+    robot = getattr(sim, "robot", None)
+    if robot is None or not getattr(robot, "foreign", False):
+        return None
+    return float(np.mean(robot.full_torque_error_deg))
 
 
 def fall_line(result, feedback) -> str | None:

@@ -130,7 +130,7 @@ def run(args) -> int:
         print(f"note: {note}", file=sys.stderr)
     health = HealthMonitor.for_robot(config, _warn_line, clock.now)
     velocity, acceleration = joint_limits_ticks(config)
-    feedback = make_feedback(config, feedback_mode(args, config), bus, clock, 1.0 / walk.rate_hz)
+    feedback = make_feedback(config, feedback_mode(args, config), bus, clock, 1.0 / walk.rate_hz, sim)
     session = WalkSession(bus, config.ids, standing_ticks(config),
                           SessionLimits(velocity, acceleration, 1.0 / walk.rate_hz), clock=clock,
                           torque_off_on_exit=config.bus.torque_off_on_exit, setup_writes=gain_writes(config),
@@ -206,6 +206,9 @@ def _report(args, config, walk: PlannedWalk, result, sim, port: str, clock, heal
     """What the walk did, on stdout (or the simulation's measurements as JSON), and the exit status."""
     if sim is not None:
         sim.extra["feedback"] = feedback.mode if feedback is not None else "none"
+        if feedback is not None:
+            sim.extra["feedback_servo_error_deg"] = round(feedback.servo_error_deg, 3)
+            sim.extra["feedback_roll_attitude_gain"] = round(config.imu.roll_gain(feedback.servo_error_deg), 4)
         sim.extra["fall_noticed"] = fall_dict(result, sim.tilt_crossed_s(config.imu.fall_tilt_deg))
     if sim is not None and args.json:
         return _sim_exit(_sim_report(sim, True, result.outcome, args.video), result.exit_code)

@@ -9,8 +9,10 @@ when it acts. Corrections (docs/feedback.md; gains per robot, ``[feedback]``):
   by +s k w_r (s = +1 left, -1 right). With the foot flat, the shank's lean is the ankle pitch and
   -s ankle roll, and the torso's pitch is hip - knee + ankle pitch (gaitbot.gait.kinematics6's
   conventions), so each term pushes against the tilting velocity: a damper in parallel with the servo.
-* attitude ("full" and "step"): the same joints by the estimated roll times ``attitude_roll_gain`` and pitch times
-  ``attitude_pitch_gain`` (deg/deg): the torso's lean held against as well as its rate.
+* attitude ("full" and "step"): the same joints by the estimated roll times the roll gain and pitch times
+  ``attitude_pitch_gain`` (deg/deg): the torso's lean held against as well as its rate. The roll gain may
+  depend on the servos' stiffness (``attitude_roll_gain_by_servo_error``): the stiffness the config writes
+  to them, or, on another author's simulated model, its own actuators' (``servo_error_deg``).
 
 Every correction is clipped to ``max_correction_deg``, then each goal to the window its joint's limits
 allow from the last two goals sent: position limits, |step| <= max velocity x frame, |change of step| <=
@@ -38,6 +40,14 @@ FALL_CROUCH_DEG = {"knee_pitch": 25.0, "hip_pitch": 12.5, "ankle_pitch": 12.5}
 """How much further the legs fold when a fall is noticed (the CoM comes down: less height to fall from)."""
 
 
+def servo_stiffness_deg(config: RobotConfig) -> float:
+    """The servos' full-torque error (deg) the feedback's gains are chosen for: ``[servo] full_torque_error_deg``
+    as the config asks it (the register's whole steps aside), else the mean of the leg servos' factory gains."""
+    if config.servo.full_torque_error_deg is not None:
+        return float(config.servo.full_torque_error_deg)
+    return float(np.mean([j.model.full_torque_error_deg for j in config.joints if j.hold_deg is None]))
+
+
 class RobotFell(Exception):
     """The IMU says the robot is falling: when (session seconds), which way, and why."""
 
@@ -50,7 +60,7 @@ class Feedback:
     """Per-frame corrections of a walk's goal rows (ticks, in ``config.joints`` order)."""
 
     def __init__(self, config: RobotConfig, mode: str, reader: ImuReader | None, period_s: float,
-                 now: Callable[[], float]) -> None:
+                 now: Callable[[], float], servo_error_deg: float | None = None) -> None:
         if mode not in MODES:
             raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
         self.config, self.mode, self.reader, self.now = config, mode, reader, now
@@ -77,7 +87,10 @@ class Feedback:
                     self.rate_gain_s[i, 0] = (1.0 if side == "left" else -1.0) * k
                 else:
                     self.rate_gain_s[i, 1] = k
-        self.attitude = np.sign(self.rate_gain_s) * [s.attitude_roll_gain, s.attitude_pitch_gain]
+        if servo_error_deg is None:
+            servo_error_deg = servo_stiffness_deg(config)
+        self.servo_error_deg = float(servo_error_deg)
+        self.attitude = np.sign(self.rate_gain_s) * [s.roll_gain(self.servo_error_deg), s.attitude_pitch_gain]
         self.max_correction_rad = math.radians(s.max_correction_deg)
         self.last: np.ndarray | None = None
         self.previous: np.ndarray | None = None

@@ -15,6 +15,8 @@
     ankle_roll_s = 0.02
     hip_roll_s = 0.01
     attitude_roll_gain = 0.0   # "full": extra correction per degree of estimated roll (deg/deg)
+    # or, instead, the roll gain by the servos' stiffness (their full-torque error, deg), interpolated:
+    # attitude_roll_gain_by_servo_error = [[6.0, 0.0], [10.0, 0.5]]
     attitude_pitch_gain = 0.0  # "full": and per degree of estimated pitch (deg/deg)
     max_correction_deg = 8.0   # no correction beyond this on any joint
 
@@ -31,11 +33,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 IMU_SOURCES = ("none", "opencr")
 FALL_RESPONSES = ("hold", "torque_off")
 IMU_KEYS = ("source", "id", "mount_rpy_deg", "gyro_noise_dps", "gyro_bias_dps", "acc_noise_g", "delay_frames")
 FEEDBACK_KEYS = ("ankle_pitch_s", "hip_pitch_s", "ankle_roll_s", "hip_roll_s", "attitude_roll_gain", "attitude_pitch_gain",
-                 "max_correction_deg")
+                 "max_correction_deg", "attitude_roll_gain_by_servo_error")
+MAX_GAIN_POINTS = 16
+MAX_ATTITUDE_GAIN = 2.0
 FALL_KEYS = ("tilt_deg", "tilt_rate_dps", "response")
 MAX_DELAY_FRAMES = 30
 MAX_GAIN_S = 1.0
@@ -63,6 +69,19 @@ class ImuSettings:
     fall_tilt_deg: float = 40.0
     fall_tilt_rate_dps: float = 250.0
     fall_response: str = "torque_off"
+    attitude_roll_gain_by_servo_error: tuple[tuple[float, float], ...] = ()
+
+    def roll_gain(self, servo_error_deg: float) -> float:
+        """The attitude roll gain for servos that give full torque at ``servo_error_deg`` of position error:
+        ``attitude_roll_gain_by_servo_error`` interpolated (flat beyond its ends), else ``attitude_roll_gain``.
+        Why by stiffness: soft servos let the torso lean under the stance leg's load faster than gyro
+        damping holds it, and the lean's correction that carries them is too much ankle torque for stiff ones
+        (docs/feedback.md, "Soft servos")."""
+        table = self.attitude_roll_gain_by_servo_error
+        if not table:
+            return self.attitude_roll_gain
+        errors, gains = zip(*table)
+        return float(np.interp(servo_error_deg, errors, gains))
 
     @property
     def present(self) -> bool:
@@ -99,8 +118,12 @@ def read_imu(fields: Any, data: dict, bus: Any) -> ImuSettings:
         raise fields.fail("imu.delay_frames", f"{delay} is outside the allowed 0..{MAX_DELAY_FRAMES}")
     gains = {k: fields.number(feedback, k, "feedback", non_negative=True, default=0.0, within=(0.0, MAX_GAIN_S, "s"))
              for k in FEEDBACK_KEYS[:4]}
-    attitude = [fields.number(feedback, k, "feedback", non_negative=True, default=0.0, within=(0.0, 2.0, ""))
+    attitude = [fields.number(feedback, k, "feedback", non_negative=True, default=0.0,
+                              within=(0.0, MAX_ATTITUDE_GAIN, ""))
                 for k in ("attitude_roll_gain", "attitude_pitch_gain")]
+    by_error = _gain_table(fields, feedback)
+    if by_error and "attitude_roll_gain" in feedback:
+        raise fields.fail("feedback.attitude_roll_gain_by_servo_error", "give it or attitude_roll_gain, not both")
     max_corr = fields.number(feedback, "max_correction_deg", "feedback", positive=True, default=8.0,
                              within=(0.0, 45.0, "deg"))
     response = fall.get("response", "torque_off")
@@ -112,4 +135,21 @@ def read_imu(fields: Any, data: dict, bus: Any) -> ImuSettings:
                        fields.number(fall, "tilt_deg", "fall", positive=True, default=40.0, within=(5.0, 90.0, "deg")),
                        fields.number(fall, "tilt_rate_dps", "fall", positive=True, default=250.0,
                                      within=(10.0, 2000.0, "deg/s")),
-                       response)
+                       response, by_error)
+
+
+def _gain_table(fields: Any, feedback: dict) -> tuple[tuple[float, float], ...]:
+    """``attitude_roll_gain_by_servo_error``: [[error_deg, gain], ...], errors rising (empty if absent)."""
+    name = "feedback.attitude_roll_gain_by_servo_error"
+    table = feedback.get("attitude_roll_gain_by_servo_error", [])
+    allowed = (f"a list of 1 to {MAX_GAIN_POINTS} [servo error deg, gain] pairs, errors rising, gains "
+               f"0..{MAX_ATTITUDE_GAIN:g}")
+    if not isinstance(table, list) or len(table) > MAX_GAIN_POINTS or (table and not all(
+            isinstance(pair, list) and len(pair) == 2 for pair in table)):
+        raise fields.fail(name, f"must be {allowed}")
+    pairs = tuple((fields.check_number(e, name, positive=True, within=(0.0, 90.0, "deg")),
+                   fields.check_number(g, name, non_negative=True, within=(0.0, MAX_ATTITUDE_GAIN, "")))
+                  for e, g in table)
+    if any(b[0] <= a[0] for a, b in zip(pairs, pairs[1:])):
+        raise fields.fail(name, f"must be {allowed}")
+    return pairs

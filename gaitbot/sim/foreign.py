@@ -148,6 +148,8 @@ class ForeignRobot(SimRobot):
 
     ``joint_names`` are the mapped gaitbot joints; angles in and out are gaitbot's (sign x the model's)."""
 
+    foreign = True  # its servos are the model's own actuators: the gains a session writes are not simulated
+
     def __init__(self, config: RobotConfig, rate_hz: float, model_path: str | Path, sim_map: SimMap) -> None:
         from gaitbot.sim.foreign_check import check_kinematics
 

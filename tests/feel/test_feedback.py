@@ -37,7 +37,8 @@ class StubReader:
 def strong_op3(**imu):
     cfg = config("op3")
     settings = dict(ankle_pitch_s=0.5, hip_pitch_s=0.5, ankle_roll_s=0.5, hip_roll_s=0.5, attitude_roll_gain=1.0,
-                    attitude_pitch_gain=1.0, max_correction_deg=30.0, fall_tilt_deg=89.0, fall_tilt_rate_dps=2000.0)
+                    attitude_pitch_gain=1.0, max_correction_deg=30.0, fall_tilt_deg=89.0, fall_tilt_rate_dps=2000.0,
+                    attitude_roll_gain_by_servo_error=())
     return dataclasses.replace(cfg, imu=dataclasses.replace(cfg.imu, **{**settings, **imu}))
 
 
@@ -189,3 +190,30 @@ def test_the_ticks_sent_keep_the_acceleration_limit_exactly_through_a_wild_gyro(
     limit = np.radians([j.max_acceleration_dps2 for j in joints]) * per_rad * PERIOD_S ** 2
     assert second.max() > 0.5 * limit.min()  # the window was reached
     assert np.all(second <= limit + 1e-9)
+
+
+@pytest.mark.parametrize("error_deg, gain", [(3.0, 0.0), (6.0, 0.0), (8.0, 0.25), (10.0, 0.5), (13.6, 0.5)])
+def test_the_roll_attitude_gain_follows_the_servos_stiffness(error_deg, gain):
+    """config/op3.toml's [[6, 0], [10, 0.5]]: none for servos as stiff as it writes them, 0.5 for soft ones (factory
+    gains, Menagerie's model), the straight line between (8 deg: half way), flat beyond the ends; the Feedback
+    uses it on the roll joints, sign as the roll damping's."""
+    cfg = config("op3")
+    assert cfg.imu.roll_gain(error_deg) == pytest.approx(gain)
+    fb = Feedback(cfg, "full", StubReader(), PERIOD_S, lambda: 0.0, servo_error_deg=error_deg)
+    roll = fb.attitude[:, 0]
+    for i, j in enumerate(cfg.joints):
+        kind, _, side = j.name.rpartition("_")
+        expected = gain * (1 if side == "left" else -1) if kind in ("hip_roll", "ankle_roll") else 0.0
+        assert roll[i] == pytest.approx(expected)
+
+
+def test_without_a_stiffness_the_feedback_takes_the_one_the_config_writes():
+    """op3 asks for 6 deg ([servo] full_torque_error_deg): the stiff end of its table, no roll attitude; without
+    that setting, the XM430-W350's factory gain (12.4 deg: soft, the full 0.5)."""
+    fb = Feedback(config("op3"), "full", StubReader(), PERIOD_S, lambda: 0.0)
+    assert fb.servo_error_deg == 6.0
+    assert not fb.attitude.any()
+    factory = dataclasses.replace(config("op3"), servo=dataclasses.replace(config("op3").servo, full_torque_error_deg=None))
+    soft = Feedback(factory, "full", StubReader(), PERIOD_S, lambda: 0.0)
+    assert soft.servo_error_deg == pytest.approx(12.4, abs=0.1)
+    assert abs(soft.attitude[:, 0]).max() == pytest.approx(0.5)

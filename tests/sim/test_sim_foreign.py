@@ -85,6 +85,11 @@ def test_a_short_walk_on_the_menagerie_op3_completes_and_its_recording_passes_ch
     # the model's own servos: kp 21.1 N m/rad, +-5 N m -> full torque at 13.6 deg (not the 6 deg gaitbot writes)
     assert report["full_torque_error_deg"][0] == pytest.approx(np.degrees(5 / 21.1), abs=0.01)
     assert "the model's own position servos" in err
+    # the feedback is told those servos' stiffness, not the 6 deg the config writes: config/op3.toml's table gives
+    # its soft end's roll attitude gain (0.5 from 10 deg)
+    assert report["feedback_servo_error_deg"] == pytest.approx(np.degrees(5 / 21.1), abs=0.01)
+    assert report["feedback_roll_attitude_gain"] == config("op3").imu.roll_gain(14.0) == 0.5
+    assert "roll attitude gain 0.5" in err
     assert run_cli(capsys, "check", record)[0] == 0
 
 
@@ -141,7 +146,8 @@ def test_strong_feedback_with_a_push_on_the_menagerie_op3_breaks_no_limit(menage
     and the goals sent are not the open-loop walk's (the feedback acted)."""
     text = (CONFIG_DIR / "op3.toml").read_text()
     for key, value in (("ankle_pitch_s", "0.3"), ("hip_pitch_s", "0.3"), ("ankle_roll_s", "0.3"), ("hip_roll_s", "0.3"),
-                       ("attitude_roll_gain", "2.0"), ("attitude_pitch_gain", "2.0"), ("max_correction_deg", "20.0")):
+                       ("attitude_roll_gain_by_servo_error", "[[6.0, 2.0]]"), ("attitude_pitch_gain", "2.0"),
+                       ("max_correction_deg", "20.0")):
         text, count = re.subn(rf"^{key} = .*$", f"{key} = {value}", text, flags=re.M)
         assert count == 1, key
     strong = tmp_path / "op3-strong.toml"

@@ -1,0 +1,44 @@
+"""``[feedback] attitude_roll_gain_by_servo_error`` in a robot config: read as written, bad ones refused in one
+line naming the field and what is allowed."""
+
+from __future__ import annotations
+
+import pytest
+
+from gaitbot.fields import FieldError
+from gaitbot.robot.config import load_robot_config
+from tests.helpers import REPO_ROOT as REPO
+
+TABLE = "attitude_roll_gain_by_servo_error = [[6.0, 0.0], [10.0, 0.5]]"
+
+
+def op3_with(tmp_path, replacement: str):
+    text = (REPO / "config" / "op3.toml").read_text()
+    assert TABLE in text
+    path = tmp_path / "op3.toml"
+    path.write_text(text.replace(TABLE, replacement))
+    return load_robot_config(path)
+
+
+def test_the_shipped_table_is_read_as_written():
+    assert load_robot_config(REPO / "config" / "op3.toml").imu.attitude_roll_gain_by_servo_error == ((6.0, 0.0), (10.0, 0.5))
+
+
+@pytest.mark.parametrize("replacement", [
+    "attitude_roll_gain_by_servo_error = [[10.0, 0.5], [6.0, 0.0]]",   # errors not rising
+    "attitude_roll_gain_by_servo_error = [[6.0, 3.0]]",                # gain beyond 2
+    "attitude_roll_gain_by_servo_error = [[6.0]]",                     # not a pair
+    "attitude_roll_gain_by_servo_error = 0.5",                         # not a list
+    "attitude_roll_gain_by_servo_error = [[-1.0, 0.2]]",               # a negative error
+    f"{TABLE}\nattitude_roll_gain = 0.3",                              # both ways at once
+])
+def test_a_bad_table_is_refused_naming_the_field(tmp_path, replacement):
+    with pytest.raises(FieldError) as caught:
+        op3_with(tmp_path, replacement)
+    message = str(caught.value)
+    assert "feedback.attitude_roll_gain" in message and "\n" not in message
+
+
+def test_a_flat_gain_still_works_without_the_table(tmp_path):
+    cfg = op3_with(tmp_path, "attitude_roll_gain = 0.3")
+    assert cfg.imu.roll_gain(6.0) == cfg.imu.roll_gain(13.0) == 0.3
