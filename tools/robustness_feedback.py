@@ -3,7 +3,7 @@
     python tools/robustness_feedback.py            # the table, as text (about 2 minutes on a 2-core machine)
     python tools/robustness_feedback.py --quick    # its first row (the 2 m walk on our model) and the route check
     python tools/robustness_feedback.py --json     # one JSON object per walk
-    python tools/robustness_feedback.py --markdown # docs/balance-robustness.md's figures (tools/figures.py)
+    python tools/robustness_feedback.py --markdown # docs/robustness-feedback.md's figures (tools/figures.py)
 
 tools/robustness.py plays the planned walk open loop, outside the session: no IMU, no feedback. Here every
 walk is ``gaitbot walk --sim --json --robot op3 ARGS --sim-model ROBOT.xml --sim-map MAP.toml --feedback
@@ -207,7 +207,7 @@ def cell(r: dict) -> str:
     """One walk's outcome; a fall shows its time and way alone (a tumbling body's figures are chaos)."""
     if r["fell"]:
         return f"FELL at {r['fell_at_s']:.1f} s, {r['fall_direction']}"
-    return (f"{100 * r['travel']:.0f}%, drift {100 * r['drift_m']:+.1f} cm, yaw {r['yaw_deg']:.1f} deg, "
+    return (f"{100 * r['travel']:.1f}%, drift {100 * r['drift_m']:+.1f} cm, yaw {r['yaw_deg']:.1f} deg, "
             f"RMS {r['roll_rms_deg']:.2f} / {r['pitch_rms_deg']:.2f} deg")
 
 
@@ -250,7 +250,7 @@ def main(argv=None) -> int:
     parser.add_argument("--json", action="store_true", help="one JSON object per row")
     parser.add_argument("--quick", action="store_true", help="the first row and the route check (about 15 s)")
     parser.add_argument("--markdown", action="store_true",
-                        help="the figures of docs/balance-robustness.md (tools/figures.py)")
+                        help="the figures of docs/robustness-feedback.md (tools/figures.py)")
     args = parser.parse_args(argv)
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
