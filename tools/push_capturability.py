@@ -85,7 +85,7 @@ class Situation:
     mass_kg: float
     feet_m: dict
     stance: str
-    lift_s: float | None  # the other foot lifts then (it is down at the push), None: it swings already
+    lift_s: float | None  # the other foot lifts then (it is down at the push; inf: never), None: it swings already
     land_s: float | None  # its planned landing; None: no step planned (standing)
     step_s: float
     double_s: float
@@ -266,12 +266,13 @@ class PlannedState:
 
 
 def plan_walk(robot: str, walk_args: str) -> PlannedState:
-    """The walk ``gaitbot walk --sim --robot ROBOT WALK_ARGS`` walks, planned by gaitbot's own planner."""
+    """The walk ``gaitbot walk --sim --robot ROBOT WALK_ARGS`` walks, planned by gaitbot's own planner (the
+    same plan with or without ``--sim``: the simulation changes the bus, not the plan)."""
     from gaitbot.app.cli import build_parser
     from gaitbot.app.planned_walk import planned_walk
     from gaitbot.sim.walk import walk_plan
 
-    args = build_parser().parse_args(["walk", "--sim", "--robot", robot, *walk_args.split()])
+    args = build_parser().parse_args(["walk", "--robot", robot, *walk_args.split()])
     planned = planned_walk(args)
     return PlannedState(planned.source.robot, planned.plan.walk, walk_plan(planned.plan, planned.planned),
                         planned.plan.fit.balance.crouch_knee_deg)

@@ -1,0 +1,103 @@
+"""tools/push_capturability.py, the capturability bound on push survival, against closed forms it does not use:
+standing on both feet, a push is caught by the ankles alone iff the capture point it moves stays in the soles'
+rectangle (J / (m omega) along the push, or for a push of duration T the same with the ZMP held on the edge
+during it); the planned walk unpushed is always capturable; a larger push in the same direction at the same
+moment is never easier to catch."""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
+import push_capturability as pc  # noqa: E402
+from helpers import config  # noqa: E402
+
+G = 9.81
+
+
+def standing(cfg, z_c: float = 0.235) -> pc.Situation:
+    """Both feet down side by side, the CoM still above their middle (ankle points at y = +-hip_width / 2)."""
+    g = cfg.body.geometry
+    half = g.hip_width_m / 2
+    sole_x, sole_y = pc.sole_edges(g)
+    return pc.Situation(t_s=0.0, xi0_m=(0.0, 0.0), omega=math.sqrt(G / z_c), mass_kg=cfg.body.total_kg,
+                        feet_m={"left": (0.0, half), "right": (0.0, -half)}, stance="left", lift_s=math.inf,
+                        land_s=None, step_s=0.4, double_s=0.0, speedup=1.0, sole_x_m=sole_x, sole_y_m=sole_y)
+
+
+def ankle_threshold_n_s(cfg, z_c: float, direction_deg: float, duration_s: float) -> float:
+    """The largest push the ankles hold standing, from the sole's rectangle (the geometry's own numbers): the
+    distance from the capture point (the feet's middle) to the rectangle's edge along the push, times m omega;
+    for a push of duration T with the ZMP held at the edge e, xi(T) - e = (xi0 - e) e^(wT) + F/(m w^2)(e^(wT) - 1)
+    <= 0 gives J <= (e - xi0) m w (wT) / (1 - e^(-wT))."""
+    g = cfg.body.geometry
+    front = g.foot_m - g.heel_back_m  # the heel is as far behind the ankle: both edges equally far
+    side = g.hip_width_m / 2 + g.sole_outward_m + g.foot_width_m / 2
+    a = math.radians(direction_deg)
+    reach = min(front / abs(math.cos(a)) if abs(math.cos(a)) > 1e-12 else math.inf,
+                side / abs(math.sin(a)) if abs(math.sin(a)) > 1e-12 else math.inf)
+    w = math.sqrt(G / z_c)
+    factor = 1.0 if duration_s == 0 else w * duration_s / (1 - math.exp(-w * duration_s))
+    return reach * cfg.body.total_kg * w * factor
+
+
+@settings(max_examples=40, deadline=None)
+@given(direction=st.floats(0, 360), duration=st.sampled_from([0.0, 0.1]), z_c=st.floats(0.15, 0.3))
+def test_standing_the_ankles_alone_catch_a_push_iff_its_capture_point_stays_on_the_soles(direction, duration, z_c):
+    cfg = config("op3")
+    sit = standing(cfg, z_c)
+    box = pc.StepBox(0.05, 0.03, 0.063, 0.11)  # no step is planned standing: the limits are not used
+    limit = ankle_threshold_n_s(cfg, z_c, direction, duration)
+    assert pc.capturable(sit, 0.99 * limit, direction, box, duration_s=duration)["ok"]
+    assert not pc.capturable(sit, 1.01 * limit, direction, box, duration_s=duration)["ok"]
+
+
+@pytest.fixture(scope="module")
+def walk():
+    from push_survival import WALKS
+
+    return pc.plan_walk("op3", WALKS["op3"])
+
+
+@pytest.mark.parametrize("phase", [i / 20 for i in range(21)])
+def test_the_planned_walk_unpushed_is_always_capturable(walk, phase):
+    sit = pc.situation_at(walk, pc.push_time_s(walk, phase))
+    for box in (pc.steer_box(walk), pc.reach_box(walk)):
+        assert pc.capturable(sit, 0.0, 0.0, box)["ok"]
+
+
+@settings(max_examples=25, deadline=None)
+@given(direction=st.floats(0, 360), phase=st.floats(0, 1), small=st.floats(0, 2.5), more=st.floats(0, 1.5))
+def test_a_larger_push_the_same_way_at_the_same_moment_is_never_easier(walk, direction, phase, small, more):
+    sit = pc.situation_at(walk, pc.push_time_s(walk, phase))
+    for box in (pc.steer_box(walk), pc.reach_box(walk)):
+        if pc.capturable(sit, small + more, direction, box)["ok"]:
+            assert pc.capturable(sit, small, direction, box)["ok"]
+
+
+def test_looser_limits_never_catch_fewer(walk):
+    # (b) contains (a), and letting the feet cross or land at once contains both: a relaxation never loses a push
+    for impulse, direction, phase in pc.draws(30, 23, 2.0):
+        sit = pc.situation_at(walk, pc.push_time_s(walk, phase))
+        a = pc.capturable(sit, impulse, direction, pc.steer_box(walk))["ok"]
+        b = pc.capturable(sit, impulse, direction, pc.reach_box(walk))["ok"]
+        free = pc.capturable(sit, impulse, direction, pc.crossing(pc.reach_box(walk)), immediate=True)["ok"]
+        assert (not a or b) and (not b or free)
+
+
+def test_the_step_boxes_follow_the_config(walk):
+    cfg = walk.config
+    g, lim = cfg.body.geometry, cfg.steer
+    a = pc.steer_box(walk)
+    # soles 17 mm apart side by side (hip width 70 mm, soles 78 mm wide, 12.5 mm outward): 7 mm of slack inward
+    assert a.spread_min_m == pytest.approx(g.hip_width_m - (0.017 - lim.min_gap_m), abs=1e-9)
+    assert a.spread_max_m == pytest.approx(g.hip_width_m + lim.max_side_m)
+    assert a.backward_m == lim.max_backward_m and a.forward_m >= lim.max_forward_m
+    r = pc.reach_m(walk)
+    assert 0 < r < g.thigh_m + g.shank_m
