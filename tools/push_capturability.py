@@ -187,9 +187,10 @@ def _step_rows(sit: Situation, axis: int, steps: int, box: StepBox):
 
 
 def axis_capturable(sit: Situation, axis: int, steps: int, first_land_s: float, box: StepBox,
-                    shift_m: float, duration_s: float = PUSH_DURATION_S) -> bool:
+                    shift_m: float, duration_s: float = PUSH_DURATION_S, hip_m: float = 0.0) -> bool:
     """Whether some footholds (within ``box``) and ZMP keep this axis's capture point caught: the linear
-    program of the module docstring (the ZMP's weighted means over the segments eliminated)."""
+    program of the module docstring (the ZMP's weighted means over the segments eliminated); ``hip_m``: how
+    far the torso's swing may move the capture point back (referred to the push's start; hip_allowance_m)."""
     push_end = sit.t_s + duration_s
     segs, final, end = timeline(sit, steps, first_land_s, push_end)
     w = sit.omega
@@ -212,7 +213,7 @@ def axis_capturable(sit: Situation, axis: int, steps: int, first_land_s: float, 
         (flc, flk), (fuc, fuk) = _bounds(sit, axis, final, order_of.get(final, True), steps)
         # x0 - sum W U <= tail * U_final and tail * L_final <= x0 - sum W L
         rows = step_a + [-hi_sum - tail * fuc, lo_sum + tail * flc]
-        rhs = step_b + [tail * fuk + hi_c - x0, x0 - lo_c - tail * flk]
+        rhs = step_b + [tail * fuk + hi_c - x0 + hip_m, x0 - lo_c - tail * flk + hip_m]
         if _feasible(np.array(rows).reshape(len(rows), steps), np.array(rhs), steps):
             return True
     return False
@@ -234,7 +235,7 @@ def landing_times(sit: Situation, immediate: bool = False) -> list[float]:
 
 
 def capturable(sit: Situation, impulse_n_s: float, direction_deg: float, box: StepBox,
-               immediate: bool = False, duration_s: float = PUSH_DURATION_S) -> dict:
+               immediate: bool = False, duration_s: float = PUSH_DURATION_S, hip_m=(0.0, 0.0)) -> dict:
     """Whether the push is caught: with N = 0..MAX_STEPS steps and some landing time, both axes at once.
     Returns {"ok", "steps", "axes_alone"} (axes_alone: whether each axis alone could be caught)."""
     shift = push_shift_m(sit, impulse_n_s, duration_s)
@@ -245,7 +246,7 @@ def capturable(sit: Situation, impulse_n_s: float, direction_deg: float, box: St
     if sit.land_s is not None:
         plans += [(n, t) for n in range(1, MAX_STEPS + 1) for t in landing_times(sit, immediate)]
     for n, t in plans:
-        ok = [axis_capturable(sit, axis, n, t, box, shifts[axis], duration_s) for axis in (0, 1)]
+        ok = [axis_capturable(sit, axis, n, t, box, shifts[axis], duration_s, hip_m[axis]) for axis in (0, 1)]
         alone = [x or y for x, y in zip(alone, ok)]
         if all(ok):
             return {"ok": True, "steps": n, "axes_alone": alone}
@@ -355,6 +356,37 @@ def _spread_min(config) -> float:
     return g.foot_width_m - 2 * g.sole_outward_m + config.steer.min_gap_m
 
 
+HIP_LEAN_DEG = 30.0
+"""The torso's swing the hip allowance grants, each way, in pitch and in roll: inside the hip joints' range at the
+walking crouch, and under the op3's fall threshold (40 deg of tilt)."""
+
+
+def hip_allowance_m(config, omega: float) -> tuple[float, float]:
+    """How far swinging the torso about the hips could move the capture point back (m; x by the hip pitch
+    joints, y by the hip roll joints), referred to the push's start: Pratt et al.'s flywheel (the torso a
+    wheel at the CoM, its torque tau moving the centroidal moment pivot tau / (m g) from the ZMP). Both hips'
+    stall torque, the joints' speed and acceleration limits, a swing of HIP_LEAN_DEG stopped at its end: a
+    bang-coast-bang profile, the pivot moved +tau / (m g) while the torso speeds up (t_a) and back while it
+    stops (from t_b): tau / (m g) ((1 - e^(-w t_a)) - (e^(-w t_b) - e^(-w (t_b + t_a)))). Generous: applied at
+    the push's start, and the torso's way back upright (which undoes it) left out."""
+    torso, joints = config.body.torso, {j.name: j for j in config.joints}
+    hip_height = config.body.geometry.hip_below_root_m
+    d = np.asarray(torso.com_m) + [0.0, 0.0, hip_height]  # the torso's CoM from the hips' midpoint
+    out = []
+    for axis, joint in ((1, "hip_pitch_left"), (0, "hip_roll_left")):  # pitch turns about y, roll about x
+        j = joints[joint]
+        inertia = torso.inertia_kg_m2[axis, axis] + torso.mass_kg * (float(d @ d) - d[axis] ** 2)
+        torque = 2 * (config.servo.stall_torque_nm or j.model.stall_torque_nm)
+        accel = min(torque / inertia, math.radians(j.max_acceleration_dps2))
+        rate = math.radians(j.max_velocity_dps)
+        lean = math.radians(HIP_LEAN_DEG)
+        t_a = min(rate / accel, math.sqrt(lean / accel))
+        t_b = lean / (accel * t_a)  # the swing's area: accel t_a (t_b - t_a) + accel t_a^2 = lean
+        pivot = accel * inertia / (config.body.total_kg * GRAVITY_M_S2)
+        out.append(pivot * ((1 - math.exp(-omega * t_a)) - (math.exp(-omega * t_b) - math.exp(-omega * (t_b + t_a)))))
+    return out[0], out[1]
+
+
 def crossing(box: StepBox) -> StepBox:
     """The same limits with the feet allowed across each other (a reason's test, not a robot's step)."""
     return replace(box, spread_min_m=-box.spread_max_m)
@@ -365,14 +397,15 @@ def crossing(box: StepBox) -> StepBox:
 AXES = ("forward-backward", "sideways")
 
 
-def verdict(sit: Situation, impulse: float, direction: float, box: StepBox, relaxations: dict) -> dict:
+def verdict(sit: Situation, impulse: float, direction: float, box: StepBox, relaxations: dict,
+            hip_m=(0.0, 0.0)) -> dict:
     """Capturable or not; if not, the axis that cannot be caught and which one relaxation would catch it."""
-    result = capturable(sit, impulse, direction, box)
+    result = capturable(sit, impulse, direction, box, hip_m=hip_m)
     if result["ok"]:
         return {"capturable": True, "steps": result["steps"], "why": None}
     axes = [name for name, ok in zip(AXES, result["axes_alone"]) if not ok] or ["both at one timing"]
     helps = [name for name, (other, immediate) in relaxations.items()
-             if capturable(sit, impulse, direction, other, immediate=immediate)["ok"]]
+             if capturable(sit, impulse, direction, other, immediate=immediate, hip_m=hip_m)["ok"]]
     return {"capturable": False, "steps": None,
             "why": " and ".join(axes) + ("; caught with " + " or ".join(helps) + " lifted" if helps else "")}
 
@@ -400,11 +433,15 @@ def push_time_s(state: PlannedState, phase: float) -> float:
 
 
 def analyse(state: PlannedState, impulse: float, direction: float, t_s: float, mass_kg: float | None = None) -> dict:
-    """One push under (a) the step limits and (b) the legs' reach."""
+    """One push under (a) the step limits and (b) the legs' reach, each without and with the hip allowance."""
     sit = situation_at(state, t_s, mass_kg)
-    a, b = steer_box(state), reach_box(state)
-    return {"a": verdict(sit, impulse, direction, a, relaxations_of(state, a, False)),
-            "b": verdict(sit, impulse, direction, b, relaxations_of(state, b, True))}
+    hip = hip_allowance_m(state.config, sit.omega)
+    out = {}
+    for key, box, reach in (("a", steer_box(state), False), ("b", reach_box(state), True)):
+        relax = relaxations_of(state, box, reach)
+        out[key] = verdict(sit, impulse, direction, box, relax)
+        out[key + "_hip"] = verdict(sit, impulse, direction, box, relax, hip)
+    return out
 
 
 def menagerie_mass_kg() -> float:
@@ -452,13 +489,15 @@ def markdown(args, rows: list[dict], menagerie: list[dict]) -> str:
     """docs/feedback.md's figure: capturable pushes per quarter of the impulse range, why the others are not,
     and the two Menagerie pushes."""
     edges = np.linspace(0, args.max_impulse, 5)
-    counts = np.zeros((4, 3), dtype=int)
+    keys = ("a", "a_hip", "b", "b_hip")
+    counts = np.zeros((4, 1 + len(keys)), dtype=int)
     for row in rows:
         q = min(int(row["impulse_n_s"] / args.max_impulse * 4), 3)
-        counts[q] += (1, row["a"]["capturable"], row["b"]["capturable"])
-    out = ["| impulse N s | pushes | capturable, (a) step limits | capturable, (b) legs' reach |", "|---|---|---|---|"]
-    out += [f"| {edges[q]:g} to {edges[q + 1]:g} | {counts[q, 0]} | {counts[q, 1]} | {counts[q, 2]} |" for q in range(4)]
-    out.append(f"| all | {counts[:, 0].sum()} | {counts[:, 1].sum()} | {counts[:, 2].sum()} |")
+        counts[q] += (1, *(row[k]["capturable"] for k in keys))
+    out = ["| impulse N s | pushes | (a) step limits | (a) and the hips | (b) legs' reach | (b) and the hips |",
+           "|---|---|---|---|---|---|"]
+    out += [f"| {edges[q]:g} to {edges[q + 1]:g} | " + " | ".join(str(c) for c in counts[q]) + " |" for q in range(4)]
+    out.append("| all | " + " | ".join(str(c) for c in counts.sum(axis=0)) + " |")
     out += ["", "| not capturable under | why (the axis; the one constraint that, lifted, would catch it) | pushes |",
             "|---|---|---|"]
     for key, name in (("a", "(a)"), ("b", "(b)")):
@@ -467,9 +506,9 @@ def markdown(args, rows: list[dict], menagerie: list[dict]) -> str:
             if not row[key]["capturable"]:
                 whys[row[key]["why"]] = whys.get(row[key]["why"], 0) + 1
         out += [f"| {name} | {why} | {count} |" for why, count in sorted(whys.items(), key=lambda kv: -kv[1])]
-    out += ["", "| Menagerie's OP3 push | capturable, (a) | capturable, (b) |", "|---|---|---|"]
-    out += [f"| {m['impulse_n_s']:g} N s at {m['direction_deg']:g} deg | {_cell(m['a'])} | {_cell(m['b'])} |"
-            for m in menagerie]
+    out += ["", "| Menagerie's OP3 push | (a) step limits | (a) and the hips | (b) legs' reach |", "|---|---|---|---|"]
+    out += [f"| {m['impulse_n_s']:g} N s at {m['direction_deg']:g} deg | {_cell(m['a'])} | {_cell(m['a_hip'])} | "
+            f"{_cell(m['b'])} |" for m in menagerie]
     return "<!-- figure push-capturability -->\n" + "\n".join(out) + "\n<!-- /figure -->"
 
 
@@ -491,17 +530,19 @@ def main(argv=None) -> int:
         for row in [*rows, *menagerie]:
             print(json.dumps(row))
         return 0
-    print("| push | impulse N s | direction deg | phase | (a) step limits | (b) legs' reach |")
-    print("|---|---|---|---|---|---|")
+    print("| push | impulse N s | direction deg | phase | (a) step limits | (a) and the hips | (b) legs' reach |")
+    print("|---|---|---|---|---|---|---|")
     for r in rows:
         print(f"| {r['push']} | {r['impulse_n_s']:.2f} | {r['direction_deg']:.0f} | {r['phase']:.2f} | "
-              f"{_cell(r['a'])} | {_cell(r['b'])} |")
-    count = {k: sum(r[k]["capturable"] for r in rows) for k in "ab"}
+              f"{_cell(r['a'])} | {_cell(r['a_hip'])} | {_cell(r['b'])} |")
+    count = {k: sum(r[k]["capturable"] for r in rows) for k in ("a", "a_hip", "b", "b_hip")}
     print(f"\n{args.robot}, {args.pushes} pushes of 0..{args.max_impulse:g} N s (seed {args.seed}): capturable "
-          f"{count['a']} under the step limits, {count['b']} within the legs' reach")
+          f"{count['a']} under the step limits ({count['a_hip']} with the hips), {count['b']} within the legs' "
+          f"reach ({count['b_hip']} with the hips)")
     for m in menagerie:
         print(f"Menagerie's OP3 ({m['mass_kg']:g} kg, {MENAGERIE_WALK}), {m['impulse_n_s']:g} N s at "
-              f"{m['direction_deg']:g} deg at {m['start_s']:g} s: (a) {_cell(m['a'])}; (b) {_cell(m['b'])}")
+              f"{m['direction_deg']:g} deg at {m['start_s']:g} s: (a) {_cell(m['a'])}; (a) and the hips "
+              f"{_cell(m['a_hip'])}; (b) {_cell(m['b'])}")
     return 0
 
 

@@ -82,10 +82,14 @@ def test_a_larger_push_the_same_way_at_the_same_moment_is_never_easier(walk, dir
 
 
 def test_looser_limits_never_catch_fewer(walk):
-    # (b) contains (a), and letting the feet cross or land at once contains both: a relaxation never loses a push
+    # (b) contains (a), and letting the feet cross or land at once contains both; the hips only add: a
+    # relaxation never loses a push
     for impulse, direction, phase in pc.draws(30, 23, 2.0):
         sit = pc.situation_at(walk, pc.push_time_s(walk, phase))
         a = pc.capturable(sit, impulse, direction, pc.steer_box(walk))["ok"]
+        hips = pc.capturable(sit, impulse, direction, pc.steer_box(walk), hip_m=pc.hip_allowance_m(walk.config,
+                                                                                                   sit.omega))["ok"]
+        assert not a or hips
         b = pc.capturable(sit, impulse, direction, pc.reach_box(walk))["ok"]
         free = pc.capturable(sit, impulse, direction, pc.crossing(pc.reach_box(walk)), immediate=True)["ok"]
         assert (not a or b) and (not b or free)
@@ -101,3 +105,23 @@ def test_the_step_boxes_follow_the_config(walk):
     assert a.backward_m == lim.max_backward_m and a.forward_m >= lim.max_forward_m
     r = pc.reach_m(walk)
     assert 0 < r < g.thigh_m + g.shank_m
+
+
+def test_the_hip_allowance_is_the_flywheel_bound():
+    # without the servos' speed limit the torso swings bang-bang to HIP_LEAN_DEG (no coast) and the capture point
+    # moves back by tau / (m g) (1 - e^(-w t))^2, t = sqrt(lean I / tau) (Pratt et al.'s flywheel); with the limit,
+    # the pivot moves only while the torso speeds up or stops, so the allowance is smaller
+    from dataclasses import replace
+
+    cfg = config("op3")
+    omega = math.sqrt(G / 0.235)
+    fast = replace(cfg, joints=tuple(replace(j, max_velocity_dps=1e9, max_acceleration_dps2=1e12) for j in cfg.joints))
+    torso, hip = cfg.body.torso, cfg.body.geometry.hip_below_root_m
+    dx, dz = torso.com_m[0], torso.com_m[2] + hip
+    inertia = torso.inertia_kg_m2[1, 1] + torso.mass_kg * (dx * dx + dz * dz)
+    tau = 2 * next(j for j in cfg.joints if j.name == "hip_pitch_left").model.stall_torque_nm
+    t = math.sqrt(math.radians(pc.HIP_LEAN_DEG) * inertia / tau)
+    expected = tau / (cfg.body.total_kg * G) * (1 - math.exp(-omega * t)) ** 2
+    assert pc.hip_allowance_m(fast, omega)[0] == pytest.approx(expected, rel=1e-9)
+    limited = pc.hip_allowance_m(cfg, omega)
+    assert 0 < limited[0] < expected and 0 < limited[1]
