@@ -470,7 +470,9 @@ def menagerie_rows(robot: str) -> list[dict]:
 
 
 def _cell(v: dict) -> str:
-    return f"yes ({v['steps']} steps)" if v["capturable"] else f"no ({v['why']})"
+    if not v["capturable"]:
+        return f"no ({v['why']})"
+    return f"yes ({v['steps']} step{'' if v['steps'] == 1 else 's'})"
 
 
 def table_rows(args) -> list[dict]:
