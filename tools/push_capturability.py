@@ -1,7 +1,7 @@
 """What any controller could catch: N-step capturability of the push-survival pushes on a linear inverted pendulum.
 
     python tools/push_capturability.py              # the 100 pushes of tools/push_survival.py, op3: a row each
-    python tools/push_capturability.py --markdown   # docs/feedback.md's figure: capturable per quarter of impulse
+    python tools/push_capturability.py --markdown   # the docs' figures (docs/capturability.md, docs/feedback.md)
     python tools/push_capturability.py --json       # one JSON object per push
 
 An upper bound on push survival, computed, not simulated (Koolen et al., "Capturability-based analysis and
@@ -488,8 +488,8 @@ def table_rows(args) -> list[dict]:
 
 
 def markdown(args, rows: list[dict], menagerie: list[dict]) -> str:
-    """docs/feedback.md's figure: capturable pushes per quarter of the impulse range, why the others are not,
-    and the two Menagerie pushes."""
+    """The docs' figures: capturable pushes per quarter of the impulse range (docs/capturability.md), why the
+    others are not and the two Menagerie pushes (the same page), and one sentence (docs/feedback.md)."""
     edges = np.linspace(0, args.max_impulse, 5)
     keys = ("a", "a_hip", "b", "b_hip")
     counts = np.zeros((4, 1 + len(keys)), dtype=int)
@@ -499,19 +499,24 @@ def markdown(args, rows: list[dict], menagerie: list[dict]) -> str:
     out = ["| impulse N s | pushes | (a) step limits | (a) and the hips | (b) legs' reach | (b) and the hips |",
            "|---|---|---|---|---|---|"]
     out += [f"| {edges[q]:g} to {edges[q + 1]:g} | " + " | ".join(str(c) for c in counts[q]) + " |" for q in range(4)]
-    out.append("| all | " + " | ".join(str(c) for c in counts.sum(axis=0)) + " |")
-    out += ["", "| not capturable under | why (the axis; the one constraint that, lifted, would catch it) | pushes |",
-            "|---|---|---|"]
+    total = counts.sum(axis=0)
+    out.append("| all | " + " | ".join(str(c) for c in total) + " |")
+    why = ["| not capturable under | why (the axis; the one constraint that, lifted, would catch it) | pushes |",
+           "|---|---|---|"]
     for key, name in (("a", "(a)"), ("b", "(b)")):
         whys: dict = {}
         for row in rows:
             if not row[key]["capturable"]:
                 whys[row[key]["why"]] = whys.get(row[key]["why"], 0) + 1
-        out += [f"| {name} | {why} | {count} |" for why, count in sorted(whys.items(), key=lambda kv: -kv[1])]
-    out += ["", "| Menagerie's OP3 push | (a) step limits | (a) and the hips | (b) legs' reach |", "|---|---|---|---|"]
-    out += [f"| {m['impulse_n_s']:g} N s at {m['direction_deg']:g} deg | {_cell(m['a'])} | {_cell(m['a_hip'])} | "
+        why += [f"| {name} | {text} | {count} |" for text, count in sorted(whys.items(), key=lambda kv: -kv[1])]
+    why += ["", "| Menagerie's OP3 push | (a) step limits | (a) and the hips | (b) legs' reach |", "|---|---|---|---|"]
+    why += [f"| {m['impulse_n_s']:g} N s at {m['direction_deg']:g} deg | {_cell(m['a'])} | {_cell(m['a_hip'])} | "
             f"{_cell(m['b'])} |" for m in menagerie]
-    return "<!-- figure push-capturability -->\n" + "\n".join(out) + "\n<!-- /figure -->"
+    summary = (f"Under the robot's step limits at most {total[1]} of the {total[0]} pushes are capturable by any "
+               f"controller ({total[2]} with the torso swung at the hips' limits); within the legs' reach, {total[3]}.")
+    return "\n".join(f"<!-- figure {name} -->\n{text}\n<!-- /figure -->" for name, text in (
+        ("push-capturability", "\n".join(out)), ("push-capturability-why", "\n".join(why)),
+        ("push-capturability-summary", summary)))
 
 
 def main(argv=None) -> int:
