@@ -125,3 +125,77 @@ def test_the_hip_allowance_is_the_flywheel_bound():
     assert pc.hip_allowance_m(fast, omega)[0] == pytest.approx(expected, rel=1e-9)
     limited = pc.hip_allowance_m(cfg, omega)
     assert 0 < limited[0] < expected and 0 < limited[1]
+
+
+def simulate_caught(sit: pc.Situation, impulse: float, direction: float, lands: list, footholds: list,
+                    dt: float = 5e-4) -> bool:
+    """An independent check: the capture point stepped forward in time (xi_dot = w (xi - p) + F / (m w), small
+    steps), the ZMP on the support's edge nearest to xi (the most it can pull xi back toward the middle), the feet landing at ``lands`` on ``footholds``
+    ((x, y) ankle points) and the old stance foot lifting after the plan's double support; caught when xi is in
+    the hull of the last two feet once the last foot is down and the push is over."""
+    w, m = sit.omega, sit.mass_kg
+    a = math.radians(direction)
+    force = (impulse / pc.PUSH_DURATION_S) * math.cos(a), (impulse / pc.PUSH_DURATION_S) * math.sin(a)
+    swing = "right" if sit.stance == "left" else "left"
+    feet = [(sit.stance, sit.feet_m[sit.stance])]  # (side, ankle) of the feet down, newest last
+    if sit.lift_s is not None:
+        feet.append((swing, sit.feet_m[swing]))
+    sides = [swing if k % 2 == 0 else sit.stance for k in range(len(lands))]
+    xi = list(sit.xi0_m)
+    t, k, lift_at = sit.t_s, 0, sit.lift_s if sit.lift_s is not None else -1.0
+    end = max([sit.t_s + pc.PUSH_DURATION_S, *lands])
+    while True:
+        if k < len(lands) and t >= lands[k] - 1e-12:
+            feet.append((sides[k], footholds[k]))
+            lift_at = t + sit.double_s
+            k += 1
+        if len(feet) == 2 and t >= lift_at - 1e-12 and k < len(lands) and lift_at >= 0:
+            feet.pop(0)
+        lo = [min(f[i] + (sit.sole_x_m[0] if i == 0 else sit.sole_y_m[s][0]) for s, f in feet) for i in (0, 1)]
+        hi = [max(f[i] + (sit.sole_x_m[1] if i == 0 else sit.sole_y_m[s][1]) for s, f in feet) for i in (0, 1)]
+        if t >= end - 1e-12:
+            return all(lo[i] - 1e-6 <= xi[i] <= hi[i] + 1e-6 for i in (0, 1))
+        pushing = t < sit.t_s + pc.PUSH_DURATION_S
+        for i in (0, 1):
+            p = lo[i] if xi[i] < 0.5 * (lo[i] + hi[i]) else hi[i]
+            xi[i] += dt * (w * (xi[i] - p) + (force[i] / (m * w) if pushing else 0.0))
+        t += dt
+
+
+def test_no_simulated_controller_catches_a_push_the_bound_says_is_lost(walk):
+    # footholds drawn at random inside the step limits (and the soles' gap), landing times from the earliest
+    # the servos allow to the planned one, the ZMP on the edge nearest the capture point: never
+    # caught where the analysis says nothing catches it; and a push it catches with no step is caught so too
+    import random
+
+    rng = random.Random(5)
+    box = pc.steer_box(walk)
+    checked = {"lost": 0, "held": 0}
+    for impulse, direction, phase in pc.draws(40, 23, 2.0):
+        sit = pc.situation_at(walk, pc.push_time_s(walk, phase))
+        verdict = pc.capturable(sit, impulse, direction, box)
+        if verdict["ok"] and verdict["steps"] == 0:
+            assert simulate_caught(sit, impulse, direction, [], [])
+            checked["held"] += 1
+        if verdict["ok"]:
+            continue
+        checked["lost"] += 1
+        earliest, planned = pc.landing_times(sit)[0], sit.land_s
+        for _ in range(80):
+            n = rng.randint(1, pc.MAX_STEPS)
+            first = rng.uniform(earliest, planned)
+            lands = [first + j * sit.step_s for j in range(n)]
+            stance = sit.feet_m[sit.stance]
+            holds, side = [], sit.swing
+            for _ in range(n):
+                s = 1.0 if side == "left" else -1.0
+                if rng.random() < 0.5:  # the limits' corners, where a step reaches furthest
+                    x = stance[0] + rng.choice((-box.backward_m, box.forward_m))
+                    y = stance[1] + s * rng.choice((box.spread_min_m, box.spread_max_m))
+                else:
+                    x = stance[0] + rng.uniform(-box.backward_m, box.forward_m)
+                    y = stance[1] + s * rng.uniform(box.spread_min_m, box.spread_max_m)
+                holds.append((x, y))
+                stance, side = (x, y), ("right" if side == "left" else "left")
+            assert not simulate_caught(sit, impulse, direction, lands, holds), (impulse, direction, phase, holds)
+    assert checked["lost"] >= 3 and checked["held"] >= 5
