@@ -425,11 +425,17 @@ def draws(pushes: int, seed: int, max_impulse: float) -> list[tuple[float, float
 
 
 def push_time_s(state: PlannedState, phase: float) -> float:
-    """When tools/push_survival.py's push of this phase starts (its phased_push)."""
-    swings = state.sim_plan.swings
-    index = len(swings) // 2
-    start, after = swings[index].start_s, swings[min(index + 1, len(swings) - 1)].start_s
-    return start + phase * max(after - start, 0.0)
+    """When tools/push_survival.py's push of this phase acts (its phased_push's start)."""
+    from push_survival import phased_push
+
+    return acting_from_s(state, phased_push(phase)(state.sim_plan, 0.0).start_s)
+
+
+def acting_from_s(state: PlannedState, start_s: float) -> float:
+    """When a push starting at ``start_s`` acts in the simulation: gaitbot.sim.walk.Pusher sets its force at
+    frame ends, so from the first frame end at or after the start."""
+    rate = 1.0 / (state.walk.t_s[1] - state.walk.t_s[0])
+    return math.ceil(start_s * rate - 1e-9) / rate
 
 
 def analyse(state: PlannedState, impulse: float, direction: float, t_s: float, mass_kg: float | None = None) -> dict:
@@ -463,7 +469,7 @@ def menagerie_rows(robot: str) -> list[dict]:
     mass = menagerie_mass_kg()
     rows = []
     for impulse, direction in MENAGERIE_PUSHES:
-        t = mid_walk_push(state.sim_plan, impulse, direction).start_s
+        t = acting_from_s(state, mid_walk_push(state.sim_plan, impulse, direction).start_s)
         rows.append({"impulse_n_s": impulse, "direction_deg": direction, "start_s": round(t, 3),
                      "mass_kg": round(mass, 4), **analyse(state, impulse, direction, t, mass)})
     return rows
@@ -525,9 +531,20 @@ def main(argv=None) -> int:
     parser.add_argument("--pushes", type=int, default=100)
     parser.add_argument("--max-impulse", type=float, default=2.0)
     parser.add_argument("--seed", type=int, default=23)
+    parser.add_argument("--max-steps", type=int, default=MAX_STEPS, choices=range(0, 6), metavar="N",
+                        help=f"the most steps a capture may take (0..5; default {MAX_STEPS})")
+    parser.add_argument("--landing-samples", type=int, default=LANDING_SAMPLES, choices=range(1, 41), metavar="K",
+                        help=f"the first landing's times tried (1..40; default {LANDING_SAMPLES})")
     parser.add_argument("--json", action="store_true", help="one JSON object per push")
     parser.add_argument("--markdown", action="store_true", help="print the docs' figure (tools/figures.py)")
     args = parser.parse_args(argv)
+    if not 1 <= args.pushes <= 10000:
+        parser.error(f"--pushes: 1 to 10000, got {args.pushes}")
+    if not (math.isfinite(args.max_impulse) and 0 < args.max_impulse <= 20):
+        parser.error(f"--max-impulse: above 0 and at most 20 N s, got {args.max_impulse:g}")
+    # the analysis's two search sizes, for a reader checking they do not matter
+    module = sys.modules[__name__]
+    module.MAX_STEPS, module.LANDING_SAMPLES = args.max_steps, args.landing_samples
     rows = table_rows(args)
     menagerie = menagerie_rows(args.robot)
     if args.markdown:
