@@ -452,8 +452,9 @@ def analyse(state: PlannedState, impulse: float, direction: float, t_s: float, m
 
 def menagerie_mass_kg() -> float:
     """The total mass of MuJoCo Menagerie's OP3 (tools/op3_menagerie.py's model, loaded by MuJoCo)."""
-    import mujoco
+    from gaitbot.sim import import_mujoco
 
+    mujoco = import_mujoco()  # with an offscreen GL backend chosen: a plain import would probe GLFW
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from op3_menagerie import menagerie_mjcf
 
@@ -514,7 +515,7 @@ def markdown(args, rows: list[dict], menagerie: list[dict]) -> str:
         for row in rows:
             if not row[key]["capturable"]:
                 whys[row[key]["why"]] = whys.get(row[key]["why"], 0) + 1
-        why += [f"| {name} | {text} | {count} |" for text, count in sorted(whys.items(), key=lambda kv: -kv[1])]
+        why += [f"| {name} | {text} | {count} |" for text, count in sorted(whys.items(), key=lambda kv: (-kv[1], kv[0]))]
     why += ["", "| Menagerie's OP3 push | (a) step limits | (a) and the hips | (b) legs' reach |", "|---|---|---|---|"]
     why += [f"| {m['impulse_n_s']:g} N s at {m['direction_deg']:g} deg | {_cell(m['a'])} | {_cell(m['a_hip'])} | "
             f"{_cell(m['b'])} |" for m in menagerie]
