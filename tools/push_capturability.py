@@ -18,7 +18,7 @@ The idealised controller:
 - the swinging (or next) foot lands at its planned time or earlier, no sooner than the rest of its swing
   played faster by the most the servos allow: the plan's peak joint velocity share s_v and acceleration
   share s_a (of max_velocity_dps, max_acceleration_dps2) allow a time scale 1 / max(s_v, sqrt(s_a))
-  (SPEED_RULE); LANDING_SAMPLES landing times from that to the planned one are tried;
+  (``speedup``); LANDING_SAMPLES landing times from that to the planned one are tried;
 - later steps at the plan's cadence (a step period after the one before, the plan's double support after
   each landing); after its last step (up to MAX_STEPS) the robot stands on both feet: xi must then be in
   their hull (N-step capturability; N = 0: no step, the feet on the floor hold it);
@@ -55,7 +55,6 @@ from gaitbot.sim.walk import PUSH_DURATION_S
 
 MAX_STEPS = 3
 LANDING_SAMPLES = 5
-SPEED_RULE = "the rest of the swing played up to 1 / max(velocity share, sqrt(acceleration share)) times faster"
 MENAGERIE_WALK = "--distance 1 --max-step 0.05 --cycle 1.0"
 MENAGERIE_PUSHES = ((1.5, 90.0), (1.5, 0.0))
 LEFT, RIGHT = "left", "right"
@@ -227,7 +226,7 @@ def _feasible(a_ub: np.ndarray, b_ub: np.ndarray, n: int) -> bool:
 
 
 def landing_times(sit: Situation, immediate: bool = False) -> list[float]:
-    """The first landing's times tried: from the earliest the servos allow (SPEED_RULE; ``immediate``: at
+    """The first landing's times tried: from the earliest the servos allow (``speedup``; ``immediate``: at
     once) to the planned one."""
     start = sit.t_s if sit.lift_s is None else max(sit.t_s, sit.lift_s)
     earliest = start if immediate else start + (sit.land_s - start) / sit.speedup
@@ -291,7 +290,9 @@ def _swing_edges(swinging: np.ndarray, rate_hz: float) -> list[tuple[str, float,
 
 
 def speedup(config, walk) -> float:
-    """How much faster than planned a swing may be played (SPEED_RULE) within the joints' limits."""
+    """How much faster than planned the rest of a swing may be played within the joints' limits: played k times
+    faster, its joint velocities scale by k and accelerations by k^2, so k = 1 / max(velocity share,
+    sqrt(acceleration share)), the plan's peak shares of max_velocity_dps and max_acceleration_dps2."""
     rate = 1.0 / (walk.t_s[1] - walk.t_s[0])
     t = np.arange(len(walk.q_rad)) / rate
     v, a = limit_shares(config, t, np.degrees(full_angles_rad(config, walk.q_rad, LEG_JOINTS)))
