@@ -26,12 +26,14 @@ The idealised controller:
   the larger of max_forward_m and the plan's own step, backward max_backward_m, outward max_side_m beyond
   the hip width), or (b) the leg's kinematic reach (each ankle a straight leg's horizontal reach R from its
   hip at the walking height, the hips between the feet: 2 R forward, backward and outward); in both, never
-  across the other foot: the soles' inner edges at least ``[steer] min_gap_m`` apart.
-The x (forward) and y (sideways) problems separate (box soles, box step limits): each is a small linear
-program in the footholds, solved for the same N and landing time. The hull of two soles is taken as its
+  across the other foot: the soles' inner edges at least ``[steer] min_gap_m`` apart;
+- and, in the columns "and the hips", the torso swung about the hips as a flywheel (``hip_allowance_m``).
+The push acts from the first frame end at or after its start, as the simulation's Pusher applies it. The x
+(forward) and y (sideways) problems separate (box soles, box step limits): each is a small linear program in
+the footholds, solved for the same N and landing time. The hull of two soles is taken as its
 bounding box, a little generous, as befits an upper bound. Why a push is not capturable: the axis that
 cannot be caught, and which one constraint lifted would catch it (the step limits: reach instead; the feet's
-gap: crossing allowed; the timing: landing at once).
+gap: crossing allowed; the servos' speed: landing at once).
 """
 
 from __future__ import annotations
@@ -516,7 +518,8 @@ def markdown(args, rows: list[dict], menagerie: list[dict]) -> str:
         for row in rows:
             if not row[key]["capturable"]:
                 whys[row[key]["why"]] = whys.get(row[key]["why"], 0) + 1
-        why += [f"| {name} | {text} | {count} |" for text, count in sorted(whys.items(), key=lambda kv: (-kv[1], kv[0]))]
+        ranked = sorted(whys.items(), key=lambda kv: (-kv[1], kv[0]))
+        why += [f"| {name} | {text} | {count} |" for text, count in ranked]
     why += ["", "| Menagerie's OP3 push | (a) step limits | (a) and the hips | (b) legs' reach |", "|---|---|---|---|"]
     why += [f"| {m['impulse_n_s']:g} N s at {m['direction_deg']:g} deg | {_cell(m['a'])} | {_cell(m['a_hip'])} | "
             f"{_cell(m['b'])} |" for m in menagerie]

@@ -130,8 +130,8 @@ def test_the_hip_allowance_is_the_flywheel_bound():
 def simulate_caught(sit: pc.Situation, impulse: float, direction: float, lands: list, footholds: list,
                     dt: float = 5e-4) -> bool:
     """An independent check: the capture point stepped forward in time (xi_dot = w (xi - p) + F / (m w), small
-    steps), the ZMP on the support's edge nearest to xi (the most it can pull xi back toward the middle), the feet landing at ``lands`` on ``footholds``
-    ((x, y) ankle points) and the old stance foot lifting after the plan's double support; caught when xi is in
+    steps), the ZMP on the support's edge nearest to xi (the most it can pull xi back toward the middle), the
+    feet landing at ``lands`` on ``footholds`` ((x, y) ankle points) and the old stance foot lifting after the plan's double support; caught when xi is in
     the hull of the last two feet once the last foot is down and the push is over."""
     w, m = sit.omega, sit.mass_kg
     a = math.radians(direction)
