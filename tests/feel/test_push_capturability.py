@@ -2,7 +2,9 @@
 standing on both feet, a push is caught by the ankles alone iff the capture point it moves stays in the soles'
 rectangle (J / (m omega) along the push, or for a push of duration T the same with the ZMP held on the edge
 during it); the planned walk unpushed is always capturable; a larger push in the same direction at the same
-moment is never easier to catch."""
+moment is never easier to catch; and against a forward integration of the capture point (its own ZMP rule,
+footholds on a grid or at random): what the bound loses no simulated step catches, what it catches with one step
+or none a simulated one catches too."""
 
 from __future__ import annotations
 
@@ -131,15 +133,16 @@ def simulate_caught(sit: pc.Situation, impulse: float, direction: float, lands: 
                     dt: float = 5e-4) -> bool:
     """An independent check: the capture point stepped forward in time (xi_dot = w (xi - p) + F / (m w), small
     steps), the ZMP on the support's edge nearest to xi (the most it can pull xi back toward the middle), the
-    feet landing at ``lands`` on ``footholds`` ((x, y) ankle points) and the old stance foot lifting after the plan's double support; caught when xi is in
-    the hull of the last two feet once the last foot is down and the push is over."""
+    feet landing at ``lands`` on ``footholds`` ((x, y) ankle points) and the old stance foot lifting after the
+    plan's double support; caught when xi is in the hull of the last two feet once the last foot is down and
+    the push is over."""
     w, m = sit.omega, sit.mass_kg
     a = math.radians(direction)
     force = (impulse / pc.PUSH_DURATION_S) * math.cos(a), (impulse / pc.PUSH_DURATION_S) * math.sin(a)
     swing = "right" if sit.stance == "left" else "left"
-    feet = [(sit.stance, sit.feet_m[sit.stance])]  # (side, ankle) of the feet down, newest last
-    if sit.lift_s is not None:
-        feet.append((swing, sit.feet_m[swing]))
+    feet = [(sit.stance, sit.feet_m[sit.stance])]  # (side, ankle) of the feet down, the next to lift first
+    if sit.lift_s is not None:  # both down at the push: the other foot lifts first
+        feet.insert(0, (swing, sit.feet_m[swing]))
     sides = [swing if k % 2 == 0 else sit.stance for k in range(len(lands))]
     xi = list(sit.xi0_m)
     t, k, lift_at = sit.t_s, 0, sit.lift_s if sit.lift_s is not None else -1.0
@@ -199,3 +202,25 @@ def test_no_simulated_controller_catches_a_push_the_bound_says_is_lost(walk):
                 stance, side = (x, y), ("right" if side == "left" else "left")
             assert not simulate_caught(sit, impulse, direction, lands, holds), (impulse, direction, phase, holds)
     assert checked["lost"] >= 3 and checked["held"] >= 5
+
+
+def test_a_push_the_bound_catches_with_one_step_is_caught_by_a_simulated_step(walk):
+    # the other way round: where the analysis catches a push with one step, some foothold on a grid inside the
+    # step limits, landing at one of the analysis's times, catches it in the forward integration too
+    import numpy as np
+
+    box = pc.steer_box(walk)
+    caught = 0
+    for impulse, direction, phase in pc.draws(40, 23, 2.0):
+        sit = pc.situation_at(walk, pc.push_time_s(walk, phase))
+        verdict = pc.capturable(sit, impulse, direction, box)
+        if verdict["steps"] != 1:
+            continue
+        stance, s = sit.feet_m[sit.stance], (1.0 if sit.swing == "left" else -1.0)
+        found = any(simulate_caught(sit, impulse, direction, [t], [(stance[0] + x, stance[1] + s * y)])
+                    for t in pc.landing_times(sit)
+                    for x in np.linspace(-box.backward_m, box.forward_m, 9)
+                    for y in np.linspace(box.spread_min_m, box.spread_max_m, 9))
+        assert found, (impulse, direction, phase)
+        caught += 1
+    assert caught >= 5
