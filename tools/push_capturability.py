@@ -523,8 +523,8 @@ def markdown(args, rows: list[dict], menagerie: list[dict]) -> str:
     why += ["", "| Menagerie's OP3 push | (a) step limits | (a) and the hips | (b) legs' reach |", "|---|---|---|---|"]
     why += [f"| {m['impulse_n_s']:g} N s at {m['direction_deg']:g} deg | {_cell(m['a'])} | {_cell(m['a_hip'])} | "
             f"{_cell(m['b'])} |" for m in menagerie]
-    summary = (f"Under the robot's step limits at most {total[1]} of the {total[0]} pushes are capturable by any "
-               f"controller ({total[2]} with the torso swung at the hips' limits); within the legs' reach, {total[3]}.")
+    summary = (f"Under the robot's step limits, steps and ankles catch at most {total[1]} of the {total[0]} pushes "
+               f"({total[2]} with the torso swung at the hips' limits as well); within the legs' reach, {total[3]}.")
     return "\n".join(f"<!-- figure {name} -->\n{text}\n<!-- /figure -->" for name, text in (
         ("push-capturability", "\n".join(out)), ("push-capturability-why", "\n".join(why)),
         ("push-capturability-summary", summary)))
