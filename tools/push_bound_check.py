@@ -44,8 +44,8 @@ def markdown(found: list[dict], feedback: str) -> str:
                      f"{'survived' if r['survived'] else 'fell'} |")
     beaten = sum(r["survived"] for r in found)
     beaten_hips = sum(r["survived"] and not r["a_hip"]["capturable"] for r in found)
-    lines += ["", f"Of the {len(found)} pushes lost under the step limits, {beaten} survived in the simulation; of those "
-              f"lost with the hips as well, {beaten_hips}."]
+    lines += ["", f"Of the {len(found)} pushes lost under the step limits, {beaten} survived in the simulation; "
+              f"of those lost with the hips as well, {beaten_hips}."]
     return "<!-- figure push-bound-check -->\n" + "\n".join(lines) + "\n<!-- /figure -->"
 
 
