@@ -41,6 +41,7 @@ from op3_menagerie import menagerie_mjcf  # noqa: E402
 
 MAP = str(ROOT / "config" / "sim-maps" / "op3-menagerie.toml")
 FAST = ("--distance", "2", "--max-step", "0.08", "--cycle", "0.8")
+PUSHED = ("--distance", "2", "--push", "0.7")  # tools/robustness_feedback.py's push row
 SLOW = ("--distance", "1", "--max-step", "0.05", "--cycle", "1.0")
 #: The issue's walks: (what the row says, gaitbot walk's arguments).
 WALKS = (
@@ -52,7 +53,8 @@ WALKS = (
 )
 MODES = ("none", "gyro", "full")
 #: The attitude terms tried (docs/feedback.md, "The OP3's gains"): a roll gain whatever the servos' stiffness.
-FLAT_ROLL = {"attitude_roll_gain_by_servo_error": "[[6.0, 0.5]]"}
+FLAT_ROLL = {"attitude_roll_gain_by_servo_error": "[[6.0, 0.4]]"}
+STRONG_ROLL = {"attitude_roll_gain_by_servo_error": "[[6.0, 0.0], [10.0, 0.5]]"}
 QUIET_ROLL = {"attitude_roll_gain_by_servo_error": "[[6.0, 0.3]]"}
 FACTORY, HALF_WAY = {"full_torque_error_deg": "12.4"}, {"full_torque_error_deg": "8.0"}  # XM430: factory gain 800
 QUIET_IMU = {"gyro_noise_dps": "0.0", "gyro_bias_dps": "0.0", "acc_noise_g": "0.0"}
@@ -117,7 +119,12 @@ def measure() -> dict:
         factory = config_variant(folder, "factory", **FACTORY)
         runs["why", "factory gyro"] = sim("--robot", factory, *FAST, "--feedback", "gyro")
         runs["why", "factory"] = sim("--robot", factory, *FAST)
+        strong = config_variant(folder, "strong", **STRONG_ROLL)
+        runs["why", "factory strong"] = sim("--robot", config_variant(folder, "factory-strong", **FACTORY, **STRONG_ROLL),
+                                            *FAST)
         runs["why", "half way"] = sim("--robot", config_variant(folder, "half-way", **HALF_WAY), *FAST)
+        runs["why", "pushed"] = sim(*on, *PUSHED)
+        runs["why", "pushed strong"] = sim("--robot", strong, *on[2:], *PUSHED)
     return runs
 
 
@@ -148,15 +155,18 @@ def why_table(runs: dict) -> str:
         (f"the sag feedforward for the model's kp (`full_torque_error_deg = {their_error_deg:.2f}`), feedback none",
          runs["why", "soft"]),
         ("feedback gyro (gyro damping alone)", runs[FAST_LABEL, "gyro"]),
-        ("feedback full as shipped (and the roll attitude, 0.5 for these servos), `--imu-seed 0`",
+        ("feedback full as shipped (and the roll attitude, 0.4 for these servos), `--imu-seed 0`",
          runs[FAST_LABEL, "full"]),
         *((f"the same, `--imu-seed {seed}`", runs["why", f"seed {seed}"]) for seed in (1, 2)),
         (f"{own} (servos at 6 deg), feedback full as shipped (no roll attitude at that stiffness)", runs["why", "own"]),
-        (f"{own}, a roll gain of 0.5 whatever the stiffness (`{FLAT_ROLL_TEXT}`)", runs["why", "flat own"]),
+        (f"{own}, a roll gain of 0.4 whatever the stiffness (`{FLAT_ROLL_TEXT}`)", runs["why", "flat own"]),
         (f"{own}, a flat roll gain of 0.3, an IMU without noise or bias", runs["why", "quiet own"]),
         (f"{own} at the XM430's factory gain (`full_torque_error_deg = 12.4`), feedback gyro", runs["why", "factory gyro"]),
-        (f"{own} at the factory gain, feedback full as shipped (roll attitude 0.5)", runs["why", "factory"]),
-        (f"{own} at 8 deg, feedback full as shipped (roll attitude 0.25)", runs["why", "half way"]),
+        (f"{own} at the factory gain, feedback full as shipped (roll attitude 0.4)", runs["why", "factory"]),
+        (f"{own} at the factory gain, roll attitude 0.5 (`{STRONG_ROLL_TEXT}`)", runs["why", "factory strong"]),
+        (f"{own} at 8 deg, feedback full as shipped (roll attitude 0.2)", runs["why", "half way"]),
+        ("Menagerie's OP3, `--distance 2 --push 0.7` (the default speed), feedback full as shipped", runs["why", "pushed"]),
+        ("the same with roll attitude 0.5", runs["why", "pushed strong"]),
     ]
     rows = ["| what changed (the 0.2 m/s walk, `--distance 2 --max-step 0.08 --cycle 0.8`, on Menagerie's OP3 unless "
             "said) | outcome | max torque / force limit | max tracking error deg |", "|---|---|---|---|"]
@@ -169,6 +179,7 @@ def why_table(runs: dict) -> str:
 
 FAST_LABEL = WALKS[0][0]
 FLAT_ROLL_TEXT = f"attitude_roll_gain_by_servo_error = {FLAT_ROLL['attitude_roll_gain_by_servo_error']}"
+STRONG_ROLL_TEXT = f"attitude_roll_gain_by_servo_error = {STRONG_ROLL['attitude_roll_gain_by_servo_error']}"
 
 
 def main(argv=None) -> int:

@@ -16,7 +16,7 @@
     hip_roll_s = 0.01
     attitude_roll_gain = 0.0   # "full": extra correction per degree of estimated roll (deg/deg)
     # or, instead, the roll gain by the servos' stiffness (their full-torque error, deg), interpolated:
-    # attitude_roll_gain_by_servo_error = [[6.0, 0.0], [10.0, 0.5]]
+    # attitude_roll_gain_by_servo_error = [[6.0, 0.0], [10.0, 0.4]]
     attitude_pitch_gain = 0.0  # "full": and per degree of estimated pitch (deg/deg)
     max_correction_deg = 8.0   # no correction beyond this on any joint
 

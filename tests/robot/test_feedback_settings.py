@@ -9,7 +9,7 @@ from gaitbot.fields import FieldError
 from gaitbot.robot.config import load_robot_config
 from tests.helpers import REPO_ROOT as REPO
 
-TABLE = "attitude_roll_gain_by_servo_error = [[6.0, 0.0], [10.0, 0.5]]"
+TABLE = "attitude_roll_gain_by_servo_error = [[6.0, 0.0], [10.0, 0.4]]"
 
 
 def op3_with(tmp_path, replacement: str):
@@ -21,7 +21,7 @@ def op3_with(tmp_path, replacement: str):
 
 
 def test_the_shipped_table_is_read_as_written():
-    assert load_robot_config(REPO / "config" / "op3.toml").imu.attitude_roll_gain_by_servo_error == ((6.0, 0.0), (10.0, 0.5))
+    assert load_robot_config(REPO / "config" / "op3.toml").imu.attitude_roll_gain_by_servo_error == ((6.0, 0.0), (10.0, 0.4))
 
 
 @pytest.mark.parametrize("replacement", [

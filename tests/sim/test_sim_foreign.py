@@ -86,10 +86,10 @@ def test_a_short_walk_on_the_menagerie_op3_completes_and_its_recording_passes_ch
     assert report["full_torque_error_deg"][0] == pytest.approx(np.degrees(5 / 21.1), abs=0.01)
     assert "the model's own position servos" in err
     # the feedback is told those servos' stiffness, not the 6 deg the config writes: config/op3.toml's table gives
-    # its soft end's roll attitude gain (0.5 from 10 deg)
+    # its soft end's roll attitude gain (0.4 from 10 deg)
     assert report["feedback_servo_error_deg"] == pytest.approx(np.degrees(5 / 21.1), abs=0.01)
-    assert report["feedback_roll_attitude_gain"] == config("op3").imu.roll_gain(14.0) == 0.5
-    assert "roll attitude gain 0.5" in err
+    assert report["feedback_roll_attitude_gain"] == config("op3").imu.roll_gain(14.0) == 0.4
+    assert "roll attitude gain 0.4" in err
     assert run_cli(capsys, "check", record)[0] == 0
 
 
