@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from gaitbot.gait.balance.correction import DEAD_BAND_M
 from helpers import config
 
 
@@ -34,14 +35,14 @@ def test_nothing_felt_walks_the_online_plan_and_a_lean_moves_the_com_within_boun
     quiet = SteppingFrames(cfg, plan, Felt(), stepping=False, correction=True)
     assert np.array_equal(np.array(list(quiet)), online)  # inside the dead band: nothing fed
     assert quiet.correction_log.max_offset_m == 0.0
-    leaning = SteppingFrames(cfg, plan, Felt(pitch_deg=6.0), stepping=False, correction={"gain": -0.3})
+    leaning = SteppingFrames(cfg, plan, Felt(pitch_deg=10.0), stepping=False, correction={"gain": -0.3})
     frames = np.array(list(leaning))
     assert frames.shape == online.shape and np.abs(frames - online).max() > 0
     log = leaning.correction_log
-    # a steady forward lean: the correction settles at -g e = 0.3 (z_c x 6 deg - the dead band), forward (3 mm
-    # on the op3), after an overshoot of the controller's integral term (about half as much again)
+    # a steady forward lean: the correction settles at -g e = 0.3 (z_c x 10 deg - the dead band), forward (3.5
+    # mm on the op3), after an overshoot of the controller's integral term (about half as much again)
     z = leaning.walker.com_height_m
-    settled = 0.3 * (z * np.radians(6.0) - 0.015)
+    settled = 0.3 * (z * np.radians(10.0) - DEAD_BAND_M)
     assert leaning.walker.com_offset_m == pytest.approx((settled, 0.0), abs=2e-4)
     assert settled < log.max_offset_m <= 1.7 * settled
     assert not leaning.log.moved  # zmp alone never moves a foothold

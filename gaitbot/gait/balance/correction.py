@@ -46,8 +46,9 @@ from gaitbot.gait.body import SIDE_SIGN, BodyGeometry
 GAIN = -0.3
 """The share of the measured error fed to the controller's state, signed (module docstring; docs/feedback.md:
 -0.3, -0.6 and 0.3 measured)."""
-DEAD_BAND_M = 0.015
-"""The capture point's error (m) below which nothing is fed: an unpushed walk's stays under 1.5 cm."""
+DEAD_BAND_M = 0.03
+"""The capture point's error (m) below which nothing is fed: at 1.5 cm (the unpushed error's size) the walk's own sway
+was fed, up to 10 ticks from the plan; at 3 cm the unpushed 0.15 m/s walk stays within 3 ticks of it."""
 JERK_WEIGHT = 1e-2
 """The correction's closed loop: preview gains of the walker's model with this jerk weight (None: the walker's
 own; 1e-3 measured alike, the walker's 1e-6 lost more pushes). Its slowest mode decays by 0.957 a frame at the
