@@ -8,6 +8,11 @@ DCM with the plan's; if it left what the ankles hold, the step's foothold moves 
 limits and the soles' gap). The steps after a moved one keep their planned length from the foot they follow
 and their side's distance from it. Every goal then goes through the session's Feedback, which keeps it
 inside every joint's position, velocity and acceleration limits (``gaitbot check`` holds it).
+
+``--feedback zmp`` walks the same way without moving footholds (``stepping=False``): instead, before each frame,
+the CoM error the IMU measured (z_c x tilt, at z_c x tilt rate, turned into the walk's world) feeds the preview
+controller's state through gaitbot.gait.balance.correction, and the walker places the body for its planned CoM
+plus the correction (``BalancedWalker.com_offset_m``), the correction's ZMP kept inside the grounded soles.
 """
 
 from __future__ import annotations
