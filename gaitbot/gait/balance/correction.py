@@ -45,7 +45,7 @@ from gaitbot.gait.body import SIDE_SIGN, BodyGeometry
 
 GAIN = -0.3
 """The share of the measured error fed to the controller's state, signed (module docstring; docs/feedback.md:
--0.3, -0.6 and 0.3 measured)."""
++0.3 lost pushes; -0.3, -0.6 and -1 survived as many as feedback full)."""
 DEAD_BAND_M = 0.03
 """The capture point's error (m) below which nothing is fed: at 1.5 cm (the unpushed error's size) the walk's own sway
 was fed, up to 10 ticks from the plan; at 3 cm the unpushed 0.15 m/s walk stays within 3 ticks of it."""
