@@ -5,9 +5,9 @@
 The IMU read itself goes over the bus (its wire time at 2 Mbaud is a fact of the packets: gaitbot.servos.opencr);
 here the reader's bus is a stub that returns a recorded-like block at once, so the figures are the host's
 work per frame: decoding the block, the complementary filter, the gyro damping, the attitude term and the
-limit window. Two lines: the feedback alone (--frames frames of a sway), and the frame a walk with feedback
+limit window. Three lines: the feedback alone (--frames frames of a sway), and the frame a walk with feedback
 really does, the online balanced walker's ``next_frame`` (30 steps queued, as tools/bench_balance.py) with the
-feedback on its goals. Both in wall time and in CPU time of this thread (time.thread_time): on a shared machine
+feedback on its goals; and ``--feedback zmp``'s CoM correction alone (its support polygon and one step). Both in wall time and in CPU time of this thread (time.thread_time): on a shared machine
 the wall p99 is the host's scheduling, the CPU p99 is the code's.
 """
 
@@ -91,6 +91,27 @@ def walker_with_feedback(config) -> str:
     return percentiles("walker next_frame + ticks + IMU read + estimate + feedback", wall, cpu, "frames")
 
 
+def correction_alone(config, frames: int) -> str:
+    """``--feedback zmp``'s own work a frame (gaitbot.gait.balance.correction): the support polygon of the
+    frame's grounded soles and one ComCorrection step, on errors beyond the dead band (always fed)."""
+    from gaitbot.gait.balance.correction import ComCorrection, support_polygon
+
+    walker = balanced_walker(config)
+    correction = ComCorrection(walker.gains)
+    rng = np.random.default_rng(0)
+    h = config.body.geometry.ankle_height_m
+    ankles = np.array([[0.0, 0.05, h], [0.03, -0.05, h]])
+    errors = rng.normal(0.0, 0.03, (frames, 4))
+    wall, cpu = np.empty(frames), np.empty(frames)
+    for k in range(frames):
+        ankles[1, 2] = h + (0.02 if k % 40 < 30 else 0.0)  # single support three frames of four
+        w, c = time.perf_counter(), time.thread_time()
+        hull = support_polygon(config.body.geometry, ankles, (0.0, 0.0))
+        correction.step(errors[k, :2], errors[k, 2:], (0.02, 0.04), hull)
+        wall[k], cpu[k] = time.perf_counter() - w, time.thread_time() - c
+    return percentiles("zmp correction (support polygon + ComCorrection.step)", wall, cpu, "frames")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robot", default="op3")
@@ -99,6 +120,7 @@ def main() -> None:
     config = load_robot_config(resolve_config(args.robot))
     print(f"{config.name}: {feedback_alone(config, args.frames)}")
     print(f"{config.name}: {walker_with_feedback(config)}")
+    print(f"{config.name}: {correction_alone(config, args.frames)}")
     print(f"{config.name}: the IMU READ's wire time at 2 Mbaud: {IMU_READ_WIRE_S * 1e3:.3f} ms (43 bytes)")
 
 

@@ -6,6 +6,7 @@
     python tools/push_survival.py --json             # one JSON object per push
     python tools/push_survival.py --markdown         # docs/feedback.md's figure: survived per quarter of the range
     python tools/push_survival.py --modes step       # capture-point stepping (--feedback step)
+    python tools/push_survival.py --modes full,zmp   # the CoM error fed to the preview controller (--feedback zmp)
 
 Each push is drawn from a seeded generator (--seed): an impulse uniform in 0..--max-impulse N s, a direction
 uniform in 0..360 deg (from forward, counter-clockwise), a phase uniform over the middle step (its share of
@@ -80,7 +81,7 @@ def markdown(args) -> str:
         rows.append(f"| {edges[q]:g} to {edges[q + 1]:g} | {counts[q, 0]} | "
                     + " | ".join(str(c) for c in counts[q, 1:]) + " |")
     rows.append(f"| all | {counts[:, 0].sum()} | " + " | ".join(str(c) for c in counts[:, 1:].sum(axis=0)) + " |")
-    name = f"push-{args.robot}" + ("-step" if "step" in modes else "")
+    name = f"push-{args.robot}" + "".join(f"-{m}" for m in ("step", "zmp") if m in modes)
     return f"<!-- figure {name} -->\n" + "\n".join(rows) + "\n<!-- /figure -->"
 
 
@@ -90,7 +91,7 @@ def main_(argv=None) -> int:
     parser.add_argument("--pushes", type=int, default=100)
     parser.add_argument("--max-impulse", type=float, default=2.0)
     parser.add_argument("--seed", type=int, default=23)
-    parser.add_argument("--modes", default="none,full", help="feedback modes, comma-separated: none, gyro, full, step")
+    parser.add_argument("--modes", default="none,full", help="feedback modes, comma-separated: none, gyro, full, step, zmp")
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--markdown", action="store_true", help="print the docs' figure (tools/figures.py)")
     args = parser.parse_args(argv)

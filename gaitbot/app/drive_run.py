@@ -118,6 +118,8 @@ def run(args) -> int:
         raise UsageError(f"--robot {args.robot or config.name}: {config.name} has no [steer] table: it cannot be driven")
     if getattr(args, "feedback", None) == "step":
         raise UsageError("--feedback step: the live drive does not move its footholds yet; use full")
+    if getattr(args, "feedback", None) == "zmp":
+        raise UsageError("--feedback zmp: the live drive does not feed its preview controller yet; use full")
     mode = feedback_mode(args, config)  # refused (one line) before anything is opened; no IMU: said once
     step_s = footstep_planner(config).step_s
     top, bottom = command_limits(config.steer, step_s)

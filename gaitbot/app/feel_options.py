@@ -8,13 +8,14 @@ import numpy as np
 
 from gaitbot.app.options import UsageError
 
-FEEDBACK_CHOICES = ("none", "gyro", "full", "step")
+FEEDBACK_CHOICES = ("none", "gyro", "full", "step", "zmp")
 
 
 def add_feedback_option(p) -> None:
     p.add_argument("--feedback", choices=FEEDBACK_CHOICES, help="correct the goals from the robot's IMU: none (open "
                    "loop), gyro (gyro damping of ankles and hips), full (and the estimated tilt), step (full, and the "
-                   "next foothold moved when a push needs a step; walk only); default: full if the robot has an "
+                   "next foothold moved when a push needs a step; walk only), zmp (full, and the measured CoM error fed to the "
+                   "walk's preview controller; walk only); default: full if the robot has an "
                    "[imu] (docs/feedback.md). A fall the IMU notices stops the walk (exit 1)")
 
 

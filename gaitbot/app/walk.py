@@ -150,15 +150,20 @@ def run(args) -> int:
             view.close()
     for note in bus.open_notes:
         print(f"note: {note}", file=sys.stderr)
-    if sim is not None and stepping is not None:
+    if sim is not None and stepping is not None and stepping.stepping:
         sim.extra["capture_steps"] = stepping.log.summary()
+    if sim is not None and stepping is not None and stepping.correction is not None:
+        sim.extra["zmp_correction"] = stepping.correction_log.summary()
     return _report(args, config, walk, result, sim, port, clock, health, feedback)
 
 
 def check_stepping(args, config, walk) -> None:
     """``--feedback step`` needs a balanced walk of planned steps (not a file or a steered walk) and the
     robot's ``[steer]`` limits (how far a foothold may move); else one line, exit 2."""
-    if getattr(args, "feedback", None) != "step":
+    mode = getattr(args, "feedback", None)
+    if mode == "zmp" and type(walk.plan) is not BalancedPlan:
+        raise UsageError("--feedback zmp: only a balanced walk of --steps or --distance is walked online")
+    if mode != "step":
         return
     if config.steer is None:
         raise UsageError(f"--feedback step: robot {config.name} has no [steer] limits (how far a step may move)")
@@ -169,11 +174,13 @@ def check_stepping(args, config, walk) -> None:
 def stepping_source(walk, config, feedback):
     """The frames of ``--feedback step``: the plan's steps walked online, the next foothold moved to catch a
     push (gaitbot.drive.stepping); None for every other mode (the planned frames as they are)."""
-    if feedback is None or feedback.mode != "step":
+    if feedback is None or feedback.mode not in ("step", "zmp"):
         return None
     from gaitbot.drive.stepping import SteppingFrames
 
-    return SteppingFrames(config, walk.plan, feedback.estimate, lambda: feedback.active)
+    zmp = feedback.mode == "zmp"
+    return SteppingFrames(config, walk.plan, feedback.estimate, lambda: feedback.active, stepping=not zmp,
+                          correction=zmp)
 
 
 def _recorder(args, config, clock, rate_hz: float) -> BusRecorder | None:

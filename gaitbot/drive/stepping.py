@@ -8,16 +8,23 @@ DCM with the plan's; if it left what the ankles hold, the step's foothold moves 
 limits and the soles' gap). The steps after a moved one keep their planned length from the foot they follow
 and their side's distance from it. Every goal then goes through the session's Feedback, which keeps it
 inside every joint's position, velocity and acceleration limits (``gaitbot check`` holds it).
+
+``--feedback zmp`` walks the same way without moving footholds (``stepping=False``): instead, before each frame,
+the CoM error the IMU measured (z_c x tilt, at z_c x tilt rate, turned into the walk's world) feeds the preview
+controller's state through gaitbot.gait.balance.correction, and the walker places the body for its planned CoM
+plus the correction (``BalancedWalker.com_offset_m``), the correction's ZMP kept inside the grounded soles.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from gaitbot.drive.step_check import StepCheck
 from gaitbot.feel.capture import CapturePoint, CaptureStep, dcm_error_m
+from gaitbot.gait.balance.correction import ComCorrection, support_polygon
 from gaitbot.gait.balance.walker import BalancedWalker
 from gaitbot.gait.balance.zmp_reference import FootPlacement
 from gaitbot.gait.body import SIDE_SIGN
@@ -60,24 +67,47 @@ class SteppingLog:
                 for t_s, c in self.moved]
 
 
+@dataclass
+class CorrectionLog:
+    """What the CoM correction did (gaitbot.gait.balance.correction): the largest correction and ZMP shift
+    (m), and the frames whose ZMP shift was cut back to the support polygon."""
+
+    frames: int = 0
+    max_offset_m: float = 0.0
+    max_zmp_shift_m: float = 0.0
+    clipped: int = 0
+
+    def summary(self) -> dict:
+        return {"frames": self.frames, "max_offset_m": round(self.max_offset_m, 4),
+                "max_zmp_shift_m": round(self.max_zmp_shift_m, 4), "clipped_frames": self.clipped}
+
+
 class SteppingFrames:
     """An iterator of tick frames: the plan's steps walked online with capture steps (module docstring).
     ``plan``: a gaitbot.robot.balanced_walk.BalancedPlan; ``estimate``: anything with roll_deg, pitch_deg,
     rates_dps and started (gaitbot.feel.estimate.TiltEstimate, the session's Feedback's); ``active``: a
-    callable saying whether the IMU may be trusted (a faulty IMU walks the plan's footholds)."""
+    callable saying whether the IMU may be trusted (a faulty IMU walks the plan's footholds).
+    ``stepping``: move footholds (``--feedback step``); ``correction``: feed the measured CoM error to the
+    preview controller's state (gaitbot.gait.balance.correction; ``--feedback zmp``), a ComCorrection's
+    keyword arguments (a dict) or True for its defaults."""
 
-    def __init__(self, config, plan, estimate, active=lambda: True) -> None:
-        if config.steer is None:
+    def __init__(self, config, plan, estimate, active=lambda: True, *, stepping: bool = True,
+                 correction=None) -> None:
+        if stepping and config.steer is None:
             raise ValueError(f"robot {config.name} has no [steer] limits: it cannot step to catch a push")
-        self.config, self.estimate, self.active = config, estimate, active
+        self.config, self.estimate, self.active, self.stepping = config, estimate, active, stepping
         fit = plan.fit
         self.walker = BalancedWalker(config.body, fit.gait, fit.balance, limits_rad=leg_limits_rad(config),
                                      kp_nm_per_rad=servo_stiffness_nm_per_rad(config))
+        self.correction = None
+        if correction:
+            self.correction = ComCorrection(self.walker.gains, **(correction if isinstance(correction, dict) else {}))
+        self.correction_log = CorrectionLog()
         self.steps = [s for s in plan.planned_steps if not s.closing]
         if self.steps and self.steps[0].leg != self.walker.next_swing_side:
             self.walker.lead_with(self.steps[0].leg)
-        self.capture = CapturePoint(config.body.geometry, config.steer)
-        self.step_check = StepCheck(config, 1.0 / self.walker.rate_hz)
+        self.capture = CapturePoint(config.body.geometry, config.steer) if stepping else None
+        self.step_check = StepCheck(config, 1.0 / self.walker.rate_hz) if stepping else None
         self.rate_hz = self.walker.rate_hz
         self.log = SteppingLog()
         self._next = 0
@@ -93,6 +123,8 @@ class SteppingFrames:
     def __next__(self) -> np.ndarray:
         if not self._append_due():
             self.walker.work()  # a share of the last append's replan, as the drive does (BalancedWalker.work)
+        if self.correction is not None:
+            self._correct()
         frame = self.walker.next_frame()
         if frame is None:
             raise StopIteration
@@ -129,6 +161,29 @@ class SteppingFrames:
         walker.append_footstep(planned, step.length_m, spread=True)
         return True
 
+    def _correct(self) -> None:
+        """The next frame's CoM correction from the measured error (none before the balance plan starts)."""
+        walker, e = self.walker, self.estimate
+        if walker._out < walker.rise_frames or walker.finished and walker._k >= walker.planned_frames:
+            return
+        error, rate = (0.0, 0.0), (0.0, 0.0)
+        if self.active() and e.started:
+            z = walker.com_height_m
+            yaw = walker.last_torso_yaw_rad()
+            c, s = math.cos(yaw), math.sin(yaw)
+            fx, fy = z * math.radians(e.pitch_deg), -z * math.radians(e.roll_deg)  # the torso's frame
+            vx, vy = z * math.radians(float(e.rates_dps[1])), -z * math.radians(float(e.rates_dps[0]))
+            error, rate = (c * fx - s * fy, s * fx + c * fy), (c * vx - s * vy, s * vx + c * vy)
+        k = walker._k
+        hull = support_polygon(self.config.body.geometry, walker._ext_at("ankles", k), walker._ext_at("yaw", k),
+                               self.correction.sole_share)
+        walker.com_offset_m = self.correction.step(error, rate, walker._ext_at("zmp", k), hull)
+        log, corr = self.correction_log, self.correction
+        log.frames += 1
+        log.max_offset_m = max(log.max_offset_m, math.hypot(*walker.com_offset_m))
+        log.max_zmp_shift_m = max(log.max_zmp_shift_m, math.hypot(*corr.zmp_shift_m))
+        log.clipped = corr.clipped
+
     def _checked(self, decision: CaptureStep, stance, swing_from, planned, length_m: float) -> CaptureStep:
         """The move, or its half, that passes the drive's step check (reach, limits, ZMP, gap); else none."""
         for _ in range(CHECK_TRIES):
@@ -153,7 +208,7 @@ class SteppingFrames:
 
     def _decide(self, stance, swing_from, planned) -> CaptureStep | None:
         e = self.estimate
-        if not (self.active() and e.started):
+        if not (self.stepping and self.active() and e.started):
             return None
         error = dcm_error_m(e.roll_deg, e.pitch_deg, float(e.rates_dps[0]), float(e.rates_dps[1]),
                             self.walker.com_height_m)

@@ -9,8 +9,8 @@ when it acts. Corrections (docs/feedback.md; gains per robot, ``[feedback]``):
   by +s k w_r (s = +1 left, -1 right). With the foot flat, the shank's lean is the ankle pitch and
   -s ankle roll, and the torso's pitch is hip - knee + ankle pitch (gaitbot.gait.kinematics6's
   conventions), so each term pushes against the tilting velocity: a damper in parallel with the servo.
-* attitude ("full" and "step"): the same joints by the estimated roll times the roll gain and pitch times
-  ``attitude_pitch_gain`` (deg/deg): the torso's lean held against as well as its rate. The roll gain may
+* attitude ("full", "step" and "zmp"): the same joints by the estimated roll times the roll gain and pitch
+  times ``attitude_pitch_gain`` (deg/deg): the torso's lean held against as well as its rate. The roll gain may
   depend on the servos' stiffness (``attitude_roll_gain_by_servo_error``): the stiffness the config writes
   to them, or, on another author's simulated model, its own actuators' (``servo_error_deg``).
 
@@ -35,7 +35,7 @@ from gaitbot.feel.imu_reader import ImuReader
 from gaitbot.robot.calibration import tick_limits
 from gaitbot.robot.config import RobotConfig
 
-MODES = ("none", "gyro", "full", "step")
+MODES = ("none", "gyro", "full", "step", "zmp")
 FALL_CROUCH_DEG = {"knee_pitch": 25.0, "hip_pitch": 12.5, "ankle_pitch": 12.5}
 """How much further the legs fold when a fall is noticed (the CoM comes down: less height to fall from)."""
 
@@ -121,7 +121,7 @@ class Feedback:
         if self.active and self.estimate.started:
             rates = np.radians(self.estimate.rates_dps[:2])
             wanted = self.rate_gain_s @ rates
-            if self.mode in ("full", "step"):  # step: full, and the walk's footholds moved (gaitbot.drive.stepping)
+            if self.mode in ("full", "step", "zmp"):  # step, zmp: full, and the walk moved (gaitbot.drive.stepping)
                 wanted = wanted + self.attitude @ np.radians([self.estimate.roll_deg, self.estimate.pitch_deg])
             wanted = np.clip(wanted, -self.max_correction_rad, self.max_correction_rad)
         # whole ticks, as sent: the next frame's window is taken from these (a window from the unrounded goals

@@ -45,3 +45,14 @@ def test_without_a_push_nothing_moves_and_other_modes_report_no_steps(capsys):
     assert report["capture_steps"] == [] and not report["fell"]
     code, out, err = run_cli(capsys, *WALK, "--feedback", "full")
     assert "capture_steps" not in json.loads(out)
+
+
+def test_the_zmp_correction_reports_itself_and_its_pushed_walks_recording_checks(tmp_path, capsys):
+    record = tmp_path / "zmp.jsonl"
+    code, out, err = run_cli(capsys, *WALK, "--feedback", "zmp", "--push", "1.0@90", "--record", record)
+    assert code in (0, 1), err
+    report = json.loads(out)
+    assert report["feedback"] == "zmp" and "capture_steps" not in report
+    felt = report["zmp_correction"]
+    assert felt["frames"] > 100 and felt["max_offset_m"] > 0.001  # the push was felt and fed
+    assert run_cli(capsys, "check", record)[0] == 0

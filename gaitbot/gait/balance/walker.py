@@ -182,6 +182,10 @@ class BalancedWalker(Lookahead):
                                        self.standing_offset, self.com_slope)
         self._rise = self.straight_path(root0[0], ankles0, rising=True)
         self._lower = None
+        self.com_offset_m = (0.0, 0.0)
+        """Added to the next balance frame's CoM (x, y; m) before the body is placed: a correction from outside
+        the plan (gaitbot.gait.balance.correction, fed by the IMU in gaitbot.drive.stepping); (0, 0) walks the
+        plan."""
 
     @property
     def period_s(self) -> float:
@@ -405,7 +409,8 @@ class BalancedWalker(Lookahead):
         (px, py), = stage2.preview_sums(e, 0, 1).tolist()
         stage2.step(-e[0, 0], -e[0, 1], -px, -py)
         s1 = self._s1_com[k]
-        com = (s1[0] + correction[0], s1[1] + correction[1])
+        extra = self.com_offset_m
+        com = (s1[0] + correction[0] + extra[0], s1[1] + correction[1] + extra[1])
         flat = self._flat
         guess = extrapolated(self._offset, self._previous_offset)
         yaws = self._yaws_at(k)
