@@ -70,11 +70,13 @@ def markdown(args) -> str:
     modes = args.modes.split(",")
     edges = np.linspace(0, args.max_impulse, 5)
     counts = np.zeros((4, 1 + len(modes)), dtype=int)
+    survived = {m: [] for m in modes}
     for n, (impulse, direction, phase) in enumerate(draws, start=1):
         quarter = min(int(impulse / args.max_impulse * 4), 3)
         counts[quarter, 0] += 1
         for i, m in enumerate(modes):
-            counts[quarter, 1 + i] += one_push(args.robot, WALKS[args.robot], impulse, direction, phase, n, m)["survived"]
+            survived[m].append(one_push(args.robot, WALKS[args.robot], impulse, direction, phase, n, m)["survived"])
+            counts[quarter, 1 + i] += survived[m][-1]
     rows = ["| impulse N s | pushes | " + " | ".join(f"survived, feedback {m}" for m in modes) + " |",
             "|---|---|" + "---|" * len(modes)]
     for q in range(4):
@@ -82,7 +84,25 @@ def markdown(args) -> str:
                     + " | ".join(str(c) for c in counts[q, 1:]) + " |")
     rows.append(f"| all | {counts[:, 0].sum()} | " + " | ".join(str(c) for c in counts[:, 1:].sum(axis=0)) + " |")
     name = f"push-{args.robot}" + "".join(f"-{m}" for m in ("step", "zmp") if m in modes)
-    return f"<!-- figure {name} -->\n" + "\n".join(rows) + "\n<!-- /figure -->"
+    return (f"<!-- figure {name} -->\n" + "\n".join(rows) + "\n<!-- /figure -->\n"
+            f"<!-- figure {name}-by-way -->\n" + by_way(draws, survived, modes) + "\n<!-- /figure -->")
+
+
+WAYS = ("forwards", "to the left", "backwards", "to the right")
+
+
+def by_way(draws, survived: dict, modes) -> str:
+    """The same pushes by the way they push (the quarter of directions centred on each) and the half of the
+    step's phase they come in: pushes, and survived per mode."""
+    rows = ["| pushed | phase | pushes | " + " | ".join(f"survived, feedback {m}" for m in modes) + " |",
+            "|---|---|---|" + "---|" * len(modes)]
+    for w, way in enumerate(WAYS):
+        for half, phases in enumerate(("first half", "second half")):
+            picked = [n for n, (_, direction, phase) in enumerate(draws)
+                      if int(((direction + 45) % 360) // 90) == w and int(phase >= 0.5) == half]
+            cells = " | ".join(str(sum(survived[m][n] for n in picked)) for m in modes)
+            rows.append(f"| {way} | {phases} | {len(picked)} | {cells} |")
+    return "\n".join(rows)
 
 
 def main_(argv=None) -> int:

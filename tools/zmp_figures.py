@@ -28,6 +28,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 
 import gaitbot.app.walk as app_walk  # noqa: E402
 import feel_figures  # noqa: E402  (the Menagerie walks, their model and their verdicts)
+from push_survival import WALKS  # noqa: E402  (the pushed walk: the op3's 0.15 m/s)
 from gaitbot.robot.calibration import trajectory_ticks  # noqa: E402
 
 MODES = ("full", "zmp")
@@ -70,7 +71,7 @@ def ticks_from_plan(mode: str, seed: int) -> int:
 
     app_walk.stepping_source = source
     try:
-        r = feel_figures.sim("--robot", "op3", *feel_figures.OWN_WALK, "--feedback", mode, "--imu-seed", str(seed))
+        r = feel_figures.sim("--robot", "op3", *WALKS["op3"].split(), "--feedback", mode, "--imu-seed", str(seed))
     finally:
         app_walk.stepping_source = original
     if r["fell"]:

@@ -47,6 +47,14 @@ class Mapped:
     actuator: int
 
 
+def substeps_per_frame(frame_s: float, timestep_s: float) -> int:
+    """Whole physics steps in a frame: the model's timestep, shortened if need be to divide the frame. A
+    timestep written to a few significant digits (0.000980392 for 1/1020 s) is taken as the divisor it
+    rounds (17 steps of a 60 Hz frame, not 18): within 1e-4 of a whole count."""
+    count = frame_s / timestep_s
+    return max(1, round(count)) if abs(count - round(count)) < 1e-4 * count else math.ceil(count)
+
+
 def load_model(mujoco, path: Path):
     """The compiled model of ``path`` (a plane floor added if it has none) and notes on what was adapted."""
     label = f"--sim-model {path}"
@@ -158,7 +166,7 @@ class ForeignRobot(SimRobot):
         self.model_path = Path(model_path)
         model, self.notes = load_model(mujoco, self.model_path)
         self.frame_s = 1.0 / rate_hz
-        self.substeps = math.ceil(self.frame_s / model.opt.timestep - 1e-6)
+        self.substeps = substeps_per_frame(self.frame_s, model.opt.timestep)
         if not math.isclose(model.opt.timestep, self.frame_s / self.substeps, rel_tol=1e-6):
             self.notes.append(f"timestep {model.opt.timestep * 1e3:.3g} ms -> {self.frame_s / self.substeps * 1e3:.3g} ms "
                               f"({self.substeps} steps a frame)")

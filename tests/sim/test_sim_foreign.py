@@ -163,3 +163,13 @@ def test_strong_feedback_with_a_push_on_the_menagerie_op3_breaks_no_limit(menage
         assert run_cli(capsys, "check", "--robot", strong, record)[0] == 0
         goals[mode] = [row["hex"] for row in read_lines(record)[1:] if row["dir"] == "tx"][:400]
     assert goals["none"] != goals["full"]
+
+
+@pytest.mark.parametrize("timestep_s, steps", [(0.002, 9), (0.000980392, 17), (1 / 1020, 17), (0.001, 17),
+                                               (0.0166667, 1), (0.02, 1)])
+def test_a_frame_holds_whole_physics_steps_a_rounded_timestep_included(timestep_s, steps):
+    """At 60 Hz: 2 ms -> 9 steps (1.85 ms each), 1 ms -> 17 (0.98 ms), and 1/1020 s written to six digits
+    (0.000980392, as MJCF files carry it) is 17 steps, not 18; a timestep longer than the frame is one step."""
+    from gaitbot.sim.foreign import substeps_per_frame
+
+    assert substeps_per_frame(1 / 60, timestep_s) == steps
