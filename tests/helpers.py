@@ -412,3 +412,20 @@ model = "XL430-W250"
 zero_tick = {zero_tick}
 direction = {direction}
 """
+
+
+class Felt:
+    """A tilt estimate that reports what it is given (what the stepping source reads of a TiltEstimate)."""
+
+    def __init__(self, roll_deg=0.0, pitch_deg=0.0, rates=(0.0, 0.0, 0.0), started=True):
+        import numpy as np
+
+        self.roll_deg, self.pitch_deg, self.rates_dps, self.started = roll_deg, pitch_deg, np.array(rates), started
+
+
+def op3_stepping_plan():
+    """The op3's balanced plan of six 6 cm steps at the 0.8 s cycle (the pushed walk's steps): (config, plan)."""
+    from gaitbot.robot.balanced_walk import balanced_gait_settings, plan_balanced
+
+    cfg = config("op3")
+    return cfg, plan_balanced(cfg, [0.06] * 6, balanced_gait_settings(cfg, cycle_s=0.8, max_step_m=0.06))

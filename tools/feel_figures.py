@@ -187,12 +187,16 @@ def main(argv=None) -> int:
     parser.add_argument("--markdown", action="store_true", help="print the docs' figures (tools/figures.py)")
     args = parser.parse_args(argv)
     runs = measure()
-    blocks = {"feel-menagerie": menagerie_table(runs), "feel-why": why_table(runs)}
-    if args.markdown:
+    print_figures({"feel-menagerie": menagerie_table(runs), "feel-why": why_table(runs)}, args.markdown)
+    return 0
+
+
+def print_figures(blocks: dict, markdown: bool) -> None:
+    """The figures as text, or as the docs' figure regions (tools/figures.py reads them)."""
+    if markdown:
         print("\n".join(f"<!-- figure {k} -->\n{v}\n<!-- /figure -->" for k, v in blocks.items()))
     else:
         print("\n\n".join(blocks.values()))
-    return 0
 
 
 if __name__ == "__main__":

@@ -92,11 +92,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--markdown", action="store_true", help="print the docs' figures (tools/figures.py)")
     args = parser.parse_args(argv)
-    blocks = {"zmp-models": models_table(), "zmp-plan": plan_sentence()}
-    if args.markdown:
-        print("\n".join(f"<!-- figure {k} -->\n{v}\n<!-- /figure -->" for k, v in blocks.items()))
-    else:
-        print("\n\n".join(blocks.values()))
+    feel_figures.print_figures({"zmp-models": models_table(), "zmp-plan": plan_sentence()}, args.markdown)
     return 0
 
 

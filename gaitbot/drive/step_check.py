@@ -28,6 +28,7 @@ import numpy as np
 
 from gaitbot.gait.balance.placement import torso_yaw
 from gaitbot.gait.balance.zmp_reference import FootPlacement, smootherstep, zmp_point
+from gaitbot.gait.convex_hull import convex_hull
 from gaitbot.gait.joints import LEG_JOINTS, SIDES
 from gaitbot.gait.kinematics6 import ReachError, leg_ik, rot_z
 from gaitbot.gait.mass import GRAVITY_M_S2
@@ -127,7 +128,7 @@ class StepCheck:
                 corners = [c for i, side in enumerate(SIDES) if grounded[i] for c in
                            sole_box(g, FootPlacement(side, float(ankles[k, i, 0]), float(ankles[k, i, 1]),
                                                      float(yaws[k, i])))]
-                hull = hulls[key] = _hull(corners) if len(corners) >= 3 else []
+                hull = hulls[key] = convex_hull(corners) if len(corners) >= 3 else []
             depth = _depth_in_hull(zmp[k], hull)
             if depth < worst:
                 worst, where = depth, k - first
@@ -208,22 +209,3 @@ def _depth_in_hull(point, hull) -> float:
         ex, ey = bx - ax, by - ay
         depth = min(depth, (ex * (py - ay) - ey * (px - ax)) / math.hypot(ex, ey))
     return depth
-
-
-def _hull(points) -> list:
-    """Convex hull, counter-clockwise (Andrew's monotone chain)."""
-    pts = sorted(set((float(x), float(y)) for x, y in points))
-
-    def cross(o, a, b) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower, upper = [], []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return lower[:-1] + upper[:-1]

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from gaitbot.feel.capture import CapturePoint, dcm_error_m
 from gaitbot.gait.balance.zmp_reference import FootPlacement
-from helpers import config
+from helpers import Felt, config, op3_stepping_plan
 
 G = 9.81
 
@@ -90,22 +90,9 @@ def test_a_push_the_ankles_hold_moves_nothing_and_a_big_one_moves_the_step_to_it
     assert pushed_back.foothold.x_m < planned.x_m
 
 
-class Felt:
-    """A tilt estimate that reports what it is given (the stepping source reads only these)."""
-
-    def __init__(self, roll_deg=0.0, pitch_deg=0.0, rates=(0.0, 0.0, 0.0), started=True):
-        self.roll_deg, self.pitch_deg, self.rates_dps, self.started = roll_deg, pitch_deg, np.array(rates), started
-
-
 @pytest.fixture(scope="module")
 def op3_plan():
-    from gaitbot.app.planned_walk import balanced_plan
-    from gaitbot.robot.walk_settings import GaitSource  # noqa: F401  (the plan's source type)
-    from gaitbot.robot.balanced_walk import balanced_gait_settings, plan_balanced
-
-    cfg = config("op3")
-    gait = balanced_gait_settings(cfg, cycle_s=0.8, max_step_m=0.06)
-    return cfg, plan_balanced(cfg, [0.06] * 6, gait)
+    return op3_stepping_plan()
 
 
 def test_nothing_felt_walks_the_plan_and_a_felt_push_left_moves_a_foothold_left(op3_plan):

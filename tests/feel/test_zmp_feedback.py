@@ -9,22 +9,12 @@ import numpy as np
 import pytest
 
 from gaitbot.gait.balance.correction import DEAD_BAND_M
-from helpers import config
-
-
-class Felt:
-    """A tilt estimate held still (the TiltEstimate's attributes the stepping source reads)."""
-
-    def __init__(self, roll_deg=0.0, pitch_deg=0.0, rates=(0.0, 0.0, 0.0), started=True):
-        self.roll_deg, self.pitch_deg, self.rates_dps, self.started = roll_deg, pitch_deg, np.array(rates), started
+from helpers import Felt, op3_stepping_plan
 
 
 @pytest.fixture(scope="module")
 def op3_plan():
-    from gaitbot.robot.balanced_walk import balanced_gait_settings, plan_balanced
-
-    cfg = config("op3")
-    return cfg, plan_balanced(cfg, [0.06] * 6, balanced_gait_settings(cfg, cycle_s=0.8, max_step_m=0.06))
+    return op3_stepping_plan()
 
 
 def test_nothing_felt_walks_the_online_plan_and_a_lean_moves_the_com_within_bounds(op3_plan):

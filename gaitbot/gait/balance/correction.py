@@ -42,6 +42,7 @@ import numpy as np
 from gaitbot.gait.balance.preview import GRAVITY_M_S2, PreviewGains, preview_gains
 from gaitbot.gait.balance.zmp_reference import FootPlacement
 from gaitbot.gait.body import SIDE_SIGN, BodyGeometry
+from gaitbot.gait.convex_hull import convex_hull
 
 GAIN = -0.3
 """The share of the measured error fed to the controller's state, signed (module docstring; docs/feedback.md:
@@ -83,28 +84,6 @@ def sole_corners(geometry: BodyGeometry, foot: FootPlacement, share: float) -> l
     return [(foot.x_m + c * (fwd + a * half_l) - s * (left + b * half_w),
              foot.y_m + s * (fwd + a * half_l) + c * (left + b * half_w))
             for a, b in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
-
-
-def convex_hull(points) -> list[tuple[float, float]]:
-    """Counter-clockwise convex hull (Andrew's monotone chain)."""
-    pts = sorted(set((float(x), float(y)) for x, y in points))
-    if len(pts) < 3:
-        return pts
-
-    def cross(o, a, b) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower: list = []
-    upper: list = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return lower[:-1] + upper[:-1]
 
 
 def support_polygon(geometry: BodyGeometry, ankles, yaws, share: float = SOLE_SHARE) -> list[tuple[float, float]]:
