@@ -7,7 +7,7 @@ import pytest
 
 from gaitbot.fields import FieldError
 from gaitbot.robot.config import load_robot_config
-from tests.helpers import REPO_ROOT as REPO
+from helpers import REPO_ROOT as REPO
 
 TABLE = "attitude_roll_gain_by_servo_error = [[6.0, 0.0], [10.0, 0.4]]"
 
