@@ -180,7 +180,12 @@ def check(selected: list[Region]) -> list[str]:
 
 
 def rewrite(selected: list[Region]) -> int:
+    """Rerun the selected regions' commands, then write their output into the pages. Every command runs before
+    any page is read, so a page edited while a long figure runs keeps the edit."""
     cache: dict[str, dict[str, str]] = {}
+    for region in selected:
+        if region.command not in cache:
+            cache[region.command] = run_figure_command(region.command)
     changed = 0
     for page in sorted({r.page for r in selected}):
         text = page.read_text()
@@ -192,8 +197,6 @@ def rewrite(selected: list[Region]) -> int:
             marks = (match.group(3) or "") + (match.group(4) or "")
             if name not in names or _in_code(text, match.start()):
                 return match.group(0)
-            if command not in cache:
-                cache[command] = run_figure_command(command)
             fresh = cache[command][name]
             changed += fresh != match.group(5)
             return f"<!-- figure {name}: {command}{marks} -->\n{fresh}<!-- /figure -->"
