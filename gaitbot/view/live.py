@@ -10,8 +10,10 @@ so it is said on stderr (docs/live-view.md).
 from __future__ import annotations
 
 import sys
+import threading
 
 from gaitbot.errors import UserError
+from gaitbot.view.channels import STATIC_CHANNELS
 from gaitbot.view.ros2_messages import schema_text
 from gaitbot.view.telemetry import NEEDS_VIEW_EXTRA
 from gaitbot.view.teleop import TeleopInbox
@@ -33,10 +35,15 @@ def import_foxglove():
     return foxglove, Capability
 
 
-def _listener(foxglove, inbox: TeleopInbox):
-    """A ServerListener handing client channels and messages to the inbox (runs on the server's thread)."""
+def _listener(foxglove, inbox: TeleopInbox, static_wanted: threading.Event):
+    """A ServerListener handing client channels and messages to the inbox, and asking for the static channels
+    again when a client subscribes to one (runs on the server's thread)."""
 
     class Listener(foxglove.websocket.ServerListener):
+        def on_subscribe(self, client, channel) -> None:
+            if channel.topic in STATIC_CHANNELS:
+                static_wanted.set()
+
         def on_client_advertise(self, client, channel) -> None:
             inbox.advertise(client.id, channel.id, channel.topic, channel.encoding, channel.schema_name)
 
@@ -60,10 +67,11 @@ class FoxgloveSink:
         if host not in LOCAL_HOSTS:
             warn(f"warning: --foxglove listens on {host}:{port}: anyone who can reach it sees the robot and can steer it")
         self.context = foxglove.Context()
+        self.static_wanted = threading.Event()  # a client subscribed to a static channel: send them at the next frame
         try:
             self.server = foxglove.start_server(
                 name="gaitbot", host=host, port=port, capabilities=[capability.ClientPublish],
-                supported_encodings=["json"], server_listener=_listener(foxglove, self.inbox), context=self.context)
+                supported_encodings=["json"], server_listener=_listener(foxglove, self.inbox, self.static_wanted), context=self.context)
         except Exception as exc:  # noqa: BLE001 - the SDK's error (a port in use) in one line
             raise ViewOptionError(f"--foxglove {host}:{port}: cannot start the server: {exc}") from None
         self.host = host

@@ -31,7 +31,8 @@ class TelemetryPublisher:
 
     ``start_ns``: the wall-clock time (ns since the Unix epoch) of the walk's t = 0, so that logs and live
     messages carry real stamps (default: now). The static channels (gaitbot.view.channels.STATIC_CHANNELS)
-    go to every sink with the first frame, and again every ``STATIC_EVERY_S`` to a sink whose
+    go to every sink with the first frame, and again every ``STATIC_EVERY_S`` (and at the frame after a client
+    subscribes to one: the sink's ``static_wanted`` event) to a sink whose
     ``repeats_static`` is true (a live server: a client may connect at any time)."""
 
     def __init__(self, config: RobotConfig, sinks, start_ns: int | None = None) -> None:
@@ -45,13 +46,24 @@ class TelemetryPublisher:
         self.notes: list[str] = []
         self.frames = 0
 
+    def _static_asked(self) -> bool:
+        """A live sink's new client subscribed to a static channel (its ``static_wanted`` event), now taken."""
+        asked = False
+        for sink in self.sinks:
+            wanted = getattr(sink, "static_wanted", None)
+            if wanted is not None and wanted.is_set():
+                wanted.clear()
+                asked = True
+        return asked
+
     def on_frame(self, frame: FrameTelemetry) -> None:
         if not self.sinks:
             return
         frame = self.felt.resolve(frame)
         stamp_ns = self.start_ns + round(frame.t_s * 1e9)
         messages = frame_messages(frame, stamp_ns, self.links)
-        if self.frames == 0 or frame.t_s >= self._static_due_s:
+        asked = self._static_asked()
+        if self.frames == 0 or frame.t_s >= self._static_due_s or asked:
             first = self.frames == 0
             self._static_due_s = frame.t_s + STATIC_EVERY_S
             messages += [(topic, message, first) for topic, message in static_messages(stamp_ns, self.links, self.urdf)]
@@ -115,6 +127,16 @@ class BackgroundPublisher:
             except Exception as exc:  # noqa: BLE001 - a frame that cannot be encoded: said, the walk goes on
                 if len(self.publisher.notes) < 10:
                     self.publisher.notes.append(f"telemetry: a frame at {frame.t_s:.2f} s was not written: {exc}")
+
+    def _static_asked(self) -> bool:
+        """A live sink's new client subscribed to a static channel (its ``static_wanted`` event), now taken."""
+        asked = False
+        for sink in self.sinks:
+            wanted = getattr(sink, "static_wanted", None)
+            if wanted is not None and wanted.is_set():
+                wanted.clear()
+                asked = True
+        return asked
 
     def on_frame(self, frame: FrameTelemetry) -> None:
         if self._closed:
