@@ -224,3 +224,24 @@ def test_a_push_the_bound_catches_with_one_step_is_caught_by_a_simulated_step(wa
         assert found, (impulse, direction, phase)
         caught += 1
     assert caught >= 5
+
+
+def test_the_bound_check_counts_every_push_once_by_what_the_bound_needs():
+    """tools/push_bound_check.py --all: each push falls in exactly one row by the bound's verdict, each row
+    counts its survivors per feedback and its smallest loss, and the totals are the pushes' own."""
+    import push_bound_check as bc
+
+    def push(impulse, capturable, steps, none, full):
+        return {"impulse_n_s": impulse, "a": {"capturable": capturable, "steps": steps},
+                "survived": {"none": none, "full": full}}
+
+    found = [push(0.2, True, 0, True, True), push(0.6, True, 0, False, False), push(0.9, True, 0, False, True),
+             push(1.1, True, 1, False, True), push(1.3, True, 2, True, False), push(1.7, True, 3, False, False),
+             push(1.9, False, None, False, False)]
+    table = bc.by_need(found, ("none", "full")).splitlines()
+    rows = {line.split(" | ")[0].lstrip("| "): line.strip("| ").split(" | ")[1:] for line in table[3:-1]}
+    assert rows[bc.NEEDS[0]] == ["3", "1", "2", "0.60"]
+    assert rows[bc.NEEDS[1]] == ["1", "0", "1", "-"]
+    assert rows[bc.NEEDS[2]] == ["2", "1", "0", "1.30"]  # two steps and three in one row
+    assert rows[bc.NEEDS[3]] == ["1", "0", "0", "1.90"]
+    assert rows["all"] == ["7", "2", "3", "0.60"]
