@@ -428,10 +428,10 @@ def draws(pushes: int, seed: int, max_impulse: float) -> list[tuple[float, float
 
 
 def push_time_s(state: PlannedState, phase: float) -> float:
-    """When tools/push_survival.py's push of this phase acts (its phased_push's start)."""
-    from push_survival import phased_push
+    """When tools/push_survival.py's push of this phase acts (``gaitbot walk --sim --push-phase``'s start)."""
+    from gaitbot.sim.walk import mid_walk_push
 
-    return acting_from_s(state, phased_push(phase)(state.sim_plan, 0.0).start_s)
+    return acting_from_s(state, mid_walk_push(state.sim_plan, 0.0, phase=phase).start_s)
 
 
 def acting_from_s(state: PlannedState, start_s: float) -> float:

@@ -1,6 +1,6 @@
 """Push survival in gaitbot's own simulation, with the IMU's noise, bias and one-frame delay: feedback off vs on.
 
-    python tools/push_survival.py                    # 100 pushes, op3, feedback none and full (long: ~1 h)
+    python tools/push_survival.py                    # 100 pushes, op3, feedback none and full (about 2 min)
     python tools/push_survival.py --pushes 10        # fewer
     python tools/push_survival.py --robot bioloid --max-impulse 1.0
     python tools/push_survival.py --json             # one JSON object per push
@@ -10,11 +10,17 @@
 
 Each push is drawn from a seeded generator (--seed): an impulse uniform in 0..--max-impulse N s, a direction
 uniform in 0..360 deg (from forward, counter-clockwise), a phase uniform over the middle step (its share of
-the way from the start of that step's swing window to the next one's). The walk: ``gaitbot walk --sim`` of
---walk (op3: 1 m at 0.15 m/s, cycle 0.8 s, steps of 6 cm), through the whole session and the simulated bus, the
-IMU seeded per push, its figures the robot config's ([imu]: op3 0.5 deg/s noise, 1 deg/s bias, one frame). A
-push survived: no fall (gaitbot.sim.metrics) to the end of the walk. Prints a table of every push and the
-share survived per feedback mode. Exit 1 if a walk failed to run.
+the way from the start of that step's swing window to the next one's: ``--push-phase``). The walk: ``gaitbot
+walk --sim`` of WALKS (op3: 1 m at 0.15 m/s, cycle 0.8 s, steps of 6 cm), through the whole session and the
+simulated bus, the IMU seeded by the push's number (``--imu-seed N``), so that push N is rerun alone by
+
+    gaitbot walk --sim --robot op3 --distance 1 --cycle 0.8 --max-step 0.06 --feedback full --imu-seed N \\
+        --push IMPULSE@DIRECTION --push-phase PHASE
+
+with its row's numbers as --json prints them (the walk is given the same digits). The IMU's figures are the
+robot config's ([imu]: op3 0.5 deg/s noise, 1 deg/s bias, one frame). A push survived: no fall
+(gaitbot.sim.metrics) to the end of the walk. Prints a table of every push and the share survived per
+feedback mode. Exit 1 if a walk failed to run.
 """
 
 from __future__ import annotations
@@ -27,38 +33,24 @@ import sys
 
 import numpy as np
 
-import gaitbot.sim.walk as sim_walk
 from gaitbot.app.cli import main
-from gaitbot.sim.walk import Push
 
 WALKS = {"op3": "--distance 1 --cycle 0.8 --max-step 0.06", "bioloid": "--distance 0.8 --cycle 0.8 --max-step 0.04"}
 
 
-def phased_push(phase: float):
-    """A stand-in for gaitbot.sim.walk.mid_walk_push that pushes at ``phase`` of the middle step."""
-
-    def push(plan, impulse_n_s: float, direction_deg: float = 90.0) -> Push:
-        index = len(plan.swings) // 2
-        start, after = plan.swings[index].start_s, plan.swings[min(index + 1, len(plan.swings) - 1)].start_s
-        return Push(impulse_n_s, start + phase * max(after - start, 0.0), index + 1, plan.swings[index].leg,
-                    direction_deg)
-    return push
-
-
 def one_push(robot: str, walk: str, impulse: float, direction: float, phase: float, seed: int, feedback: str) -> dict:
     """One simulated walk with one push; the row of the table."""
-    sim_walk.mid_walk_push = phased_push(phase)
     out, err = io.StringIO(), io.StringIO()
     args = ["walk", "--sim", "--json", "--robot", robot, *walk.split(), "--feedback", feedback,
             "--imu-seed", str(seed)]
     if impulse > 0:
-        args += ["--push", f"{impulse:.3f}@{direction:.1f}"]
+        args += ["--push", f"{impulse:.3f}@{direction:.1f}", "--push-phase", f"{phase:.6f}"]
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         code = main(args)
     if code not in (0, 1):
         raise RuntimeError(f"walk failed (exit {code}): {err.getvalue().strip()}")
     report = json.loads(out.getvalue())
-    return {"impulse_n_s": round(impulse, 3), "direction_deg": round(direction, 1), "phase": round(phase, 3),
+    return {"impulse_n_s": round(impulse, 3), "direction_deg": round(direction, 1), "phase": round(phase, 6),
             "feedback": feedback, "survived": not report["fell"], "fell_at_s": report["fell_at_s"],
             "fall_direction": report["fall_direction"]}
 

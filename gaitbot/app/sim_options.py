@@ -52,6 +52,25 @@ def parse_push(text: str | float | None) -> tuple[float | None, float]:
     return impulse, direction
 
 
+def add_push_phase_option(p: argparse.ArgumentParser) -> None:
+    """``walk``'s --push-phase: where in the step half-way through the walk the push comes."""
+    p.add_argument("--push-phase", type=float, metavar="P", help="--sim --push: where in that step the push "
+                   "comes: 0 as its foot lifts, 1 as the next foot lifts (its swing, then the double support "
+                   "after it; default: the middle of its swing). tools/push_survival.py's pushes, one by one")
+
+
+def check_push_phase(args) -> None:
+    """--push-phase: a share 0..1 of the step, and only with --sim --push; UsageError (one line) otherwise."""
+    phase = getattr(args, "push_phase", None)
+    if phase is None:
+        return
+    if not getattr(args, "sim", False) or getattr(args, "push", None) is None:
+        raise UsageError("--push-phase: only with --sim and --push (when in the step the push comes)")
+    if not (math.isfinite(phase) and 0.0 <= phase <= 1.0):
+        raise UsageError(f"--push-phase must be a share of the step from 0 (its foot lifts) to 1 (the next foot "
+                         f"lifts), got {phase!r}")
+
+
 def check_sim_model(args) -> None:
     """--sim-model and --sim-map go together, with --sim, free-floating; the files must be readable."""
     model, mapping = getattr(args, "sim_model", None), getattr(args, "sim_map", None)

@@ -19,7 +19,8 @@ from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeo
 from gaitbot.app.planned_walk import PlannedWalk, planned_walk
 from gaitbot.app.outputs import output_path
 from gaitbot.app.progress import callback, progress
-from gaitbot.app.sim_options import add_sim_model_options, check_sim_model, foreign_model, parse_push
+from gaitbot.app.sim_options import (add_push_phase_option, add_sim_model_options, check_push_phase,
+                                     check_sim_model, foreign_model, parse_push)
 from gaitbot.app.view_options import add_view_options, open_view
 from gaitbot.bus.factory import guarded, make_robot_bus
 from gaitbot.bus.recording import BusRecorder, RecordingFailed
@@ -78,6 +79,7 @@ def add_parser(subparsers):
                    "the simulated torso rides a boom, sliding forward and up, pitch held)")
     p.add_argument("--free-pitch", action="store_true", help="--sim: the boom, with the torso free to pitch on it")
     add_sim_model_options(p)  # --push, --imu-fault, --imu-seed, --sim-model, --sim-map (gaitbot.app.sim_options)
+    add_push_phase_option(p)
     add_feedback_option(p)  # --feedback (gaitbot.app.feel_options)
     p.add_argument("--video", metavar="FILE", help="--sim: render the walk to walk.gif or walk.mp4 (three-quarter view)")
     p.add_argument("--json", action="store_true", help="--sim: print the measurements as one JSON object")
@@ -112,7 +114,7 @@ def run(args) -> int:
 
         sim = SimWalk(config, walk.rate_hz, walk_plan(walk.plan, walk.planned), sim_support(args, config),
                       args.video, args.push, args.push_direction_deg, foreign_model(args), args.imu_seed,
-                      args.imu_fault)
+                      args.imu_fault, getattr(args, "push_phase", None))
         for note in getattr(sim.robot, "notes", ()):
             print(f"note: --sim-model: {note}", file=sys.stderr)
     hardware = not (args.dry_run or args.sim)
@@ -273,6 +275,7 @@ def check_sim_arguments(args) -> None:
     """Refuse what a simulated walk cannot honour, and a missing MuJoCo, before any work is done."""
     sim = getattr(args, "sim", False)
     if not sim:
+        check_push_phase(args)
         for flag in ("free_pitch", "push", "video", "json", "sim_model", "sim_map", "imu_fault"):
             if getattr(args, flag, None):
                 raise UsageError(f"--{flag.replace('_', '-')}: only with --sim (a simulated walk)")
@@ -291,6 +294,7 @@ def check_sim_arguments(args) -> None:
     args.push, args.push_direction_deg = parse_push(getattr(args, "push", None))
     if args.push is not None and (getattr(args, "boom", False) or getattr(args, "free_pitch", False)):
         raise UsageError("--push: a sideways push needs a free-floating torso (the boom holds it sideways)")
+    check_push_phase(args)
     check_sim_model(args)
     import_mujoco()
     if getattr(args, "video", None):

@@ -169,8 +169,10 @@ class SimReport:
         if self.push is not None:
             direction = self.push.get("direction_deg", 90.0)
             way = "sideways" if direction == 90.0 else f"towards {direction:g} deg from forward"
-            text += (f"\nPushed {self.push['impulse_n_s']:+.2f} N s {way} at {self.push['start_s']:.2f} s, "
-                     f"mid-swing of step {self.push['step']} ({self.push['leg']} foot swinging).")
+            phase, step, leg = self.push.get("phase"), self.push["step"], self.push["leg"]
+            where = (f"mid-swing of step {step} ({leg} foot swinging)" if phase is None else
+                     f"{phase:g} of the way through step {step} (0: the {leg} foot lifts; 1: the next foot lifts)")
+            text += f"\nPushed {self.push['impulse_n_s']:+.2f} N s {way} at {self.push['start_s']:.2f} s, {where}."
         return text
 
     def _stiffness(self) -> str:

@@ -64,15 +64,16 @@ def walk_plan(walker, trajectory: Trajectory) -> WalkPlan:
 
 @dataclass(frozen=True)
 class Push:
-    """An impulse (N s) from start_s, in the swing of step ``step``, horizontal, ``direction_deg`` from
+    """An impulse (N s) from start_s, in step ``step`` (its ``leg`` swinging), horizontal, ``direction_deg`` from
     forward (the walk's +x), counter-clockwise: 90 (the default) pushes to the left, and a negative
-    impulse the opposite way."""
+    impulse the opposite way. ``phase``: where in the step it came (mid_walk_push), None for mid-swing."""
 
     impulse_n_s: float
     start_s: float
     step: int
     leg: str
     direction_deg: float = 90.0
+    phase: float | None = None
 
     @property
     def end_s(self) -> float:
@@ -80,16 +81,24 @@ class Push:
 
     def to_dict(self) -> dict:
         return {"impulse_n_s": self.impulse_n_s, "direction_deg": self.direction_deg, "start_s": self.start_s,
-                "end_s": self.end_s, "step": self.step, "leg": self.leg}
+                "end_s": self.end_s, "step": self.step, "leg": self.leg, "phase": self.phase}
 
 
-def mid_walk_push(plan: WalkPlan, impulse_n_s: float, direction_deg: float = 90.0) -> Push:
-    """The push of ``--push``: at the middle of the swing of the step half-way through the walk."""
+def mid_walk_push(plan: WalkPlan, impulse_n_s: float, direction_deg: float = 90.0,
+                  phase: float | None = None) -> Push:
+    """The push of ``--push``, in the step half-way through the walk: at ``phase`` of it (``--push-phase``; 0
+    as its foot lifts, 1 as the next foot lifts: its swing, then the double support after it), or without
+    a phase in the middle of its swing."""
     if not plan.swings:
         raise ValueError("the walk has no steps to push in")
     index = len(plan.swings) // 2
     window = plan.swings[index]
-    return Push(impulse_n_s, 0.5 * (window.start_s + window.end_s), index + 1, window.leg, direction_deg)
+    if phase is None:
+        start_s = 0.5 * (window.start_s + window.end_s)
+    else:
+        after_s = plan.swings[min(index + 1, len(plan.swings) - 1)].start_s
+        start_s = window.start_s + phase * max(after_s - window.start_s, 0.0)
+    return Push(impulse_n_s, start_s, index + 1, window.leg, direction_deg, phase)
 
 
 class Pusher:
@@ -115,7 +124,8 @@ class SimWalk:
 
     def __init__(self, config: RobotConfig, rate_hz: float, plan: WalkPlan, support: str = "free",
                  video: str | None = None, push_n_s: float | None = None, push_direction_deg: float = 90.0,
-                 foreign: tuple | None = None, imu_seed: int = 0, imu_fault: str | None = None) -> None:
+                 foreign: tuple | None = None, imu_seed: int = 0, imu_fault: str | None = None,
+                 push_phase: float | None = None) -> None:
         """``foreign``: (model file, SimMap) of another author's model (gaitbot.sim.foreign), else gaitbot's own."""
         from gaitbot.sim.physics import SimRobot
 
@@ -137,7 +147,7 @@ class SimWalk:
         self.robot.observers.append(self.meter)
         self.push = None
         if push_n_s:
-            self.push = mid_walk_push(plan, push_n_s, push_direction_deg)
+            self.push = mid_walk_push(plan, push_n_s, push_direction_deg, push_phase)
             self.robot.observers.append(Pusher(self.push, self.robot.frame_s))
         self.video = None
         if video:

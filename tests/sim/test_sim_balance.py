@@ -128,6 +128,24 @@ def test_a_sideways_push_mid_step_is_survived(capsys):
     assert 1 <= push["step"] <= 21
 
 
+def test_the_push_phase_runs_from_the_middle_steps_lift_to_the_next_ones():
+    """--push-phase: 0 at the middle step's swing start, 1 at the next swing's start, linear between (so its
+    swing, then the double support); without it the middle of the swing. Checked against the plan's swing
+    windows, and the phase kept for the report."""
+    from gaitbot.sim.walk import SwingWindow, WalkPlan, mid_walk_push
+
+    swings = tuple(SwingWindow(leg, start, start + 0.3) for leg, start in
+                   (("left", 1.0), ("right", 1.4), ("left", 1.8), ("right", 2.2), ("left", 2.6)))
+    plan = WalkPlan(distance_m=1.0, swings=swings)
+    middle, after = swings[2], swings[3]
+    assert mid_walk_push(plan, 1.0).start_s == pytest.approx(1.8 + 0.15)
+    for phase in (0.0, 0.25, 0.75, 1.0):
+        push = mid_walk_push(plan, 1.0, 45.0, phase)
+        assert push.start_s == pytest.approx(middle.start_s + phase * (after.start_s - middle.start_s))
+        assert (push.step, push.leg, push.direction_deg, push.phase) == (3, "left", 45.0, phase)
+    assert mid_walk_push(plan, 1.0).phase is None
+
+
 def test_a_pitch_only_robot_free_standing_is_refused_and_would_fall_sideways(tmp_path, capsys):
     """A robot without hip and ankle roll cannot shift its weight over the stance foot. Its config without
     ``boom = true``: the walk is refused before anything moves (exit 1, the balance check names the ZMP),
@@ -176,6 +194,10 @@ def test_op3_on_the_boom_for_comparison(capsys):
     (["--dry-run", "--push", "0.7"], "--push: only with --sim"),
     (["--dry-run", "--free-pitch"], "--free-pitch: only with --sim"),
     (["--push", "1e9"], "--push must be a non-zero impulse of at most"),
+    (["--push-phase", "0.5"], "--push-phase: only with --sim and --push"),
+    (["--push", "0.7", "--push-phase", "1.5"], "--push-phase must be a share of the step from 0"),
+    (["--push", "0.7", "--push-phase", "-0.1"], "--push-phase must be a share of the step from 0"),
+    (["--dry-run", "--push-phase", "0.5"], "--push-phase: only with --sim and --push"),
 ])
 def test_what_a_push_or_boom_cannot_do_is_one_line_and_exit_2(args, message, capsys):
     capsys.readouterr()
