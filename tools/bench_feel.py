@@ -8,7 +8,8 @@ work per frame: decoding the block, the complementary filter, the gyro damping, 
 limit window. Three lines: the feedback alone (--frames frames of a sway), and the frame a walk with feedback
 really does, the online balanced walker's ``next_frame`` (30 steps queued, as tools/bench_balance.py) with the
 feedback on its goals; and ``--feedback zmp``'s CoM correction alone (its support polygon and one step). Both in wall time and in CPU time of this thread (time.thread_time): on a shared machine
-the wall p99 is the host's scheduling, the CPU p99 is the code's.
+the wall p99 is the host's scheduling, the CPU p99 is the code's. Last, ``--feedback step``'s frames by what
+they do (queue a step, queue a queued step again after a push, neither), in CPU time.
 """
 
 from __future__ import annotations
@@ -112,6 +113,49 @@ def correction_alone(config, frames: int) -> str:
     return percentiles("zmp correction (support polygon + ComCorrection.step)", wall, cpu, "frames")
 
 
+class LeaningFrom:
+    """A tilt estimate (what the stepping source reads) that feels nothing until ``frame``, then a lean to the
+    left: a push felt in the middle of a walk."""
+
+    def __init__(self, frame: int) -> None:
+        self.frame, self.frames, self.started = frame, 0, True
+        self.roll_deg, self.pitch_deg, self.rates_dps = 0.0, 0.0, np.zeros(3)
+
+    def tick(self) -> None:
+        self.frames += 1
+        if self.frames >= self.frame:
+            self.roll_deg, self.rates_dps = -4.0, np.array([-30.0, 0.0, 0.0])
+
+
+def stepping_frames(config, repeats: int = 5) -> list[str]:
+    """``--feedback step``'s frames (gaitbot.drive.stepping) of six 6 cm steps with a lean felt from frame
+    110: the frames that queue a step (its capture decision and whole step check), the frames that take a
+    queued step back and queue it again, and the others; CPU time of the thread."""
+    from gaitbot.drive.stepping import SteppingFrames
+    from gaitbot.robot.balanced_walk import balanced_gait_settings, plan_balanced
+
+    plan = plan_balanced(config, [0.06] * 6, balanced_gait_settings(config, cycle_s=0.8, max_step_m=0.06))
+    cpu: dict[str, list[float]] = {"queue a step": [], "queue a step again": [], "other": []}
+    for _ in range(repeats):
+        felt = LeaningFrom(110)
+        frames = SteppingFrames(config, plan, felt)
+        frames_iter = iter(frames)
+        while True:
+            steps, moved = frames.log.steps, len(frames.log.moved)
+            c = time.thread_time()
+            try:
+                next(frames_iter)
+            except StopIteration:
+                break
+            took = time.thread_time() - c
+            again = len(frames.log.moved) > moved and frames.log.moved[-1][2]
+            kind = "queue a step" if frames.log.steps > steps else "queue a step again" if again else "other"
+            cpu[kind].append(took)
+            felt.tick()
+    return [f"--feedback step, {kind}: CPU p50 {np.median(v) * 1e3:.2f} ms, max {max(v) * 1e3:.2f} ms over "
+            f"{len(v)} frames" for kind, v in cpu.items()]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robot", default="op3")
@@ -121,6 +165,8 @@ def main() -> None:
     print(f"{config.name}: {feedback_alone(config, args.frames)}")
     print(f"{config.name}: {walker_with_feedback(config)}")
     print(f"{config.name}: {correction_alone(config, args.frames)}")
+    for line in stepping_frames(config):
+        print(f"{config.name}: {line}")
     print(f"{config.name}: the IMU READ's wire time at 2 Mbaud: {IMU_READ_WIRE_S * 1e3:.3f} ms (43 bytes)")
 
 

@@ -5,8 +5,9 @@ BalancedWalker (the drive's walker, with the plan's own speed-fitted settings, s
 plan's frames), each appended DECIDE_FRAMES frames before its double support starts: about when the step before it starts,
 as the live drive queues its steps, early enough for the walker's preview to see the step coming. At that moment gaitbot.feel.capture compares the measured
 DCM with the plan's; if it left what the ankles hold, the step's foothold moves toward it (within ``[steer]``
-limits and the soles' gap). The steps after a moved one keep their planned length from the foot they follow
-and their side's distance from it. Every goal then goes through the session's Feedback, which keeps it
+limits and the soles' gap). Until that step starts, a push felt later moves it again (``_redecide``: the walker
+takes it back and it is queued to the new foothold). The steps after a moved one keep their planned length
+from the foot they follow and their side's distance from it. Every goal then goes through the session's Feedback, which keeps it
 inside every joint's position, velocity and acceleration limits (``gaitbot check`` holds it).
 
 ``--feedback zmp`` walks the same way without moving footholds (``stepping=False``): instead, before each frame,
@@ -37,6 +38,9 @@ DECIDE_FRAMES = 24
 answers a push sooner, but the walker's preview then sees the step late: unpushed, the frames leave the
 plan's by up to 20 ticks (3 at 24), and pushes that the planned walk survives fell (measured with
 python tools/push_survival.py --modes step; docs/feedback.md)."""
+REDECIDE_M = 0.01
+"""A step queued but not started is moved again when the DCM's error asks for a foothold this far (m) from the
+one it was given: a push felt after the step was queued is answered by it, not by the step after it."""
 CHECK_TRIES = 3
 """A moved step refused by the step check is tried at half the move, then at a quarter; then the plan's."""
 
@@ -51,20 +55,33 @@ class MovedStep:
 
 
 @dataclass
-class SteppingLog:
-    """The decisions taken: one CaptureStep per step that was moved (with when it was decided: s from the walk's
-    start), and how many steps the error left the hold but nothing moved (inward only, or refused by the step
-    check: the plan's foothold kept)."""
+class QueuedStep:
+    """The step appended last: where the feet stood for it (the stance foot, the swing foot's start), its
+    planned foothold and length, the foothold it was given, and whether it was moved again since."""
 
-    moved: list[tuple[float, CaptureStep]] = field(default_factory=list)
+    stance: FootPlacement
+    swing_from: FootPlacement
+    planned: FootPlacement
+    length_m: float
+    foothold: FootPlacement
+    redecided: bool = False
+
+
+@dataclass
+class SteppingLog:
+    """The decisions taken: one CaptureStep per move of a step (with when it was decided: s from the walk's
+    start, and whether the step had been queued and was moved again), and how many times the error left the
+    hold but nothing moved (inward only, or refused by the step check: the plan's foothold kept)."""
+
+    moved: list[tuple[float, CaptureStep, bool]] = field(default_factory=list)
     steps: int = 0
     refused: int = 0
 
     def summary(self) -> list[dict]:
         """The moved steps for ``--json``: when decided (s of the walk), the DCM's error and the move (m)."""
-        return [{"decided_s": round(t_s, 4), "side": c.foothold.side,
+        return [{"decided_s": round(t_s, 4), "side": c.foothold.side, "requeued": requeued,
                  "dcm_error_m": [round(v, 4) for v in c.error_m], "moved_m": [round(v, 4) for v in c.moved_m]}
-                for t_s, c in self.moved]
+                for t_s, c, requeued in self.moved]
 
 
 @dataclass
@@ -110,6 +127,7 @@ class SteppingFrames:
         self.step_check = StepCheck(config, 1.0 / self.walker.rate_hz) if stepping else None
         self.rate_hz = self.walker.rate_hz
         self.log = SteppingLog()
+        self._queued: QueuedStep | None = None  # the step appended last (moved again by _redecide)
         self._next = 0
         self._frames = len(plan.walk.t_s)
         self._append_due()  # the first step: before the walk starts, as the plan has it
@@ -121,7 +139,7 @@ class SteppingFrames:
         return self
 
     def __next__(self) -> np.ndarray:
-        if not self._append_due():
+        if not self._append_due() and not self._redecide():
             self.walker.work()  # a share of the last append's replan, as the drive does (BalancedWalker.work)
         if self.correction is not None:
             self._correct()
@@ -150,15 +168,41 @@ class SteppingFrames:
         stance, swing_from = feet[stance_side], feet[step.leg]
         planned = FootPlacement(step.leg, stance.x_m + step.length_m,
                                 stance.y_m + SIDE_SIGN[step.leg] * self.config.body.geometry.hip_width_m, 0.0)
+        queued = QueuedStep(stance, swing_from, planned, step.length_m, planned)
         decision = self._decide(stance, swing_from, planned)
         if decision is not None and decision.beyond:
-            decision = self._checked(decision, stance, swing_from, planned, step.length_m)
-            if decision.moved_m != (0.0, 0.0):
-                self.log.moved.append((walker._out / self.rate_hz, decision))
-                planned = decision.foothold
-            else:
-                self.log.refused += 1
-        walker.append_footstep(planned, step.length_m, spread=True)
+            queued.foothold = self._checked_foothold(decision, queued)
+        walker.append_footstep(queued.foothold, step.length_m, spread=True)
+        self._queued = queued if self.stepping else None
+        return True
+
+    def _checked_foothold(self, decision: CaptureStep, queued: QueuedStep, requeued: bool = False) -> FootPlacement:
+        """The foothold of a decision beyond the hold, as the step check lets it through (logged; ``requeued``:
+        a step taken back and moved again); the walker stands as before the step."""
+        decision = self._checked(decision, queued.stance, queued.swing_from, queued.planned, queued.length_m)
+        if decision.moved_m == (0.0, 0.0):
+            self.log.refused += 1
+            return queued.planned
+        self.log.moved.append((self.walker._out / self.rate_hz, decision, requeued))
+        return decision.foothold
+
+    def _redecide(self) -> bool:
+        """The step queued last, not started yet, moved again when the DCM's error now asks for a foothold
+        REDECIDE_M or more from the one it was given (a push felt after the step was queued): taken back
+        and appended to the new foothold, once a step. Whether it did."""
+        queued, walker = self._queued, self.walker
+        if queued is None or queued.redecided or not walker.last_step_unstarted:
+            return False
+        decision = self._decide(queued.stance, queued.swing_from, queued.planned)
+        if decision is None or not decision.beyond:
+            return False
+        moved = decision.foothold
+        if math.hypot(moved.x_m - queued.foothold.x_m, moved.y_m - queued.foothold.y_m) < REDECIDE_M:
+            return False
+        queued.redecided = True
+        walker.retract_last_step()
+        queued.foothold = self._checked_foothold(decision, queued, requeued=True)
+        walker.append_footstep(queued.foothold, queued.length_m, spread=True)
         return True
 
     def _correct(self) -> None:

@@ -110,9 +110,45 @@ def test_nothing_felt_walks_the_plan_and_a_felt_push_left_moves_a_foothold_left(
     leaning_left = SteppingFrames(cfg, plan, Felt(roll_deg=-4.0, rates=(-30.0, 0.0, 0.0)))
     list(leaning_left)
     assert leaning_left.log.moved
-    for _, step in leaning_left.log.moved:
+    for _, step, _ in leaning_left.log.moved:
         assert step.moved_m[1] >= 0.0 and step.error_m[1] > 0
-    assert any(step.moved_m[1] > 0.01 for _, step in leaning_left.log.moved)
+    assert any(step.moved_m[1] > 0.01 for _, step, _ in leaning_left.log.moved)
+
+
+class FeltFrom(Felt):
+    """Nothing felt until frame ``frame`` of the walk, then a lean to the left (a push felt mid-walk)."""
+
+    def __init__(self, frame):
+        super().__init__()
+        self.frame, self.frames = frame, 0
+
+    def tick(self):
+        self.frames += 1
+        if self.frames >= self.frame:
+            self.roll_deg, self.rates_dps = -4.0, np.array([-30.0, 0.0, 0.0])
+
+
+def test_a_push_felt_after_a_step_was_queued_moves_that_step_before_it_starts(op3_plan):
+    """The step queued next, not started when the push is felt, is taken back and moved at once (requeued)
+    rather than the push waiting for the next step to be queued."""
+    from gaitbot.drive.stepping import SteppingFrames
+
+    cfg, plan = op3_plan
+    quiet = SteppingFrames(cfg, plan, Felt(started=False))
+    queued_at = []  # the frames (after the first steps) at which a queued step has not started
+    for n, _ in enumerate(quiet, start=1):
+        if quiet.walker.last_step_unstarted and quiet.walker._k > 60:
+            queued_at.append(n)
+    felt_frame = queued_at[len(queued_at) // 2]
+    felt = FeltFrom(felt_frame)
+    pushed = SteppingFrames(cfg, plan, felt)
+    for _ in pushed:
+        felt.tick()
+    after = [(t, step, again) for t, step, again in pushed.log.moved if t >= (felt_frame - 1) / pushed.rate_hz]
+    t_s, step, again = after[0]
+    assert again, "the first move after the push was felt waited for a new step"
+    assert t_s <= (felt_frame + 1) / pushed.rate_hz  # at once
+    assert step.moved_m[1] > 0.005 and step.error_m[1] > 0  # to the left, where the push went
 
 
 @pytest.mark.parametrize("argv, words", [

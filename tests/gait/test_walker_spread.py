@@ -89,3 +89,53 @@ def test_twenty_minutes_of_walking_hold_bounded_memory():
     assert max(sizes) <= bound
     assert walker.plan_start_frame > frames - lookahead.STORED_FRAMES - walker.rise_frames
 
+
+
+def test_a_step_taken_back_and_appended_elsewhere_plans_as_if_appended_there_at_once():
+    """BalancedWalker.retract_last_step (a push felt after a step was queued, gaitbot.drive.stepping): the plan
+    after taking back a queued step and appending another foothold is exactly the plan of a walker that was
+    given that foothold in the first place (every per-frame array, the heel strikes and steps); a step that
+    has started cannot be taken back."""
+    from gaitbot.gait.balance.zmp_reference import FootPlacement
+
+    def walked_to(first_side_offset_m: float, retract_to_m: float | None):
+        walker = balanced_walker(OP3, GAIT)
+        walker.lead_with("left")
+        planner = footstep_planner(OP3, GAIT)
+        for n in range(3):
+            step = planner.next_step(COMMANDS[0], walker.next_swing_side)
+            walker.append_footstep(step.foothold, step.length_m)
+        for _ in range(walker.rise_frames + 30):
+            walker.next_frame()
+        stance = walker.feet["left" if walker.next_swing_side == "right" else "right"]
+        side = walker.next_swing_side
+        y = stance.y_m + (OP3.body.geometry.hip_width_m if side == "left" else -OP3.body.geometry.hip_width_m)
+        walker.append_footstep(FootPlacement(side, stance.x_m + 0.04, y + first_side_offset_m, 0.0), 0.04)
+        for _ in range(5):
+            walker.next_frame()
+        if retract_to_m is not None:
+            assert walker.last_step_unstarted
+            walker.retract_last_step()
+            walker.append_footstep(FootPlacement(side, stance.x_m + 0.04, y + retract_to_m, 0.0), 0.04)
+        return walker
+
+    direct = walked_to(0.02, None)
+    taken_back = walked_to(0.0, 0.02)
+    assert taken_back.heel_strikes == direct.heel_strikes
+    assert taken_back.planned_steps == direct.planned_steps
+    assert taken_back.planned_frames == direct.planned_frames
+    for key, a in direct.plan_arrays().items():
+        np.testing.assert_array_equal(taken_back.plan_arrays()[key], a, err_msg=key)
+    assert taken_back.heel_strikes != walked_to(0.0, None).heel_strikes  # the move did change the plan
+    while taken_back.last_step_unstarted:
+        taken_back.next_frame()
+    with pytest.raises(RuntimeError):
+        taken_back.retract_last_step()
+    # both walk on to the end, stand, and the frames after the retraction converge on the direct walker's
+    ends = []
+    for walker in (direct, taken_back):
+        frames = []
+        while (frame := walker.next_frame()) is not None:
+            frames.append(frame[1])
+        ends.append(np.array(frames[-60:]))
+    assert np.abs(ends[0] - ends[1]).max() < 1e-6

@@ -164,6 +164,7 @@ class BalancedWalker(Lookahead):
                                    balance.preview_jerk_weight)
         self.heel_strikes: list[HeelStrike] = []
         self.planned_steps: list[PlannedStep] = []
+        self._last_step: tuple | None = None  # the state before the last appended step (retract_last_step)
         self._blocks = PlanBlocks()
         self.planner.settle(self._blocks, self._state, bend=True)
         self.planner.hold(self._blocks, self._state, START_PAUSE_S)
@@ -201,6 +202,7 @@ class BalancedWalker(Lookahead):
             raise BalancedWalkError(f"step length {length_m!r} m is outside 0..{self.gait.max_step_m:g} m")
         self._record(self.planner.step(self._blocks, self._state, float(length_m)), closing=False)
         self._appended(spread)
+        self._last_step = None  # only a step appended by append_footstep is taken back
 
     def append_footstep(self, foothold: FootPlacement, length_m: float = 0.0, spread: bool = False) -> None:
         """Queue one steered step: the next swing foot (``next_swing_side``) lands at ``foothold`` (its
@@ -211,8 +213,32 @@ class BalancedWalker(Lookahead):
             raise RuntimeError("the walk has already been closed; start a new walker")
         if not all(math.isfinite(v) for v in (foothold.x_m, foothold.y_m, foothold.yaw_rad, length_m)):
             raise BalancedWalkError(f"foothold {foothold!r} is not finite")
+        before = (self._state.copy(), self._committed, len(self.heel_strikes), len(self.planned_steps))
         self._record(self.planner.step_to(self._blocks, self._state, foothold, float(length_m)), closing=False)
         self._appended(spread)
+        self._last_step = before if not self._batch else None
+
+    @property
+    def last_step_unstarted(self) -> bool:
+        """Whether the last step appended (by ``append_footstep``) may still be taken back: none of its frames
+        has been handed out, and the walk is open."""
+        return self._last_step is not None and not self.finished and self._last_step[1] > self._k
+
+    def retract_last_step(self) -> None:
+        """Take back the last step appended, which has not started (``last_step_unstarted``): the plan and
+        the walker's state are as before it, so that a step to another foothold can be appended instead
+        (a push felt after the step was queued: gaitbot.drive.stepping). Its frames' previews are redone by
+        that append's replan, which reruns the first stage from the next output frame."""
+        if not self.last_step_unstarted:
+            raise RuntimeError("the last step has started (or there is none to take back)")
+        state, committed, strikes, steps = self._last_step
+        self._last_step = None
+        self._arrays = {key: a[:committed - self._base].copy() for key, a in self._arrays.items()}
+        self._blocks.taken = committed
+        self._state = state
+        del self.heel_strikes[strikes:]
+        del self.planned_steps[steps:]
+        self._commit()
 
     def _appended(self, spread: bool) -> None:
         if not self._batch:
