@@ -76,8 +76,8 @@ def by_need(found: list[dict], feedbacks: tuple[str, ...]) -> str:
 
     def row(label: str, picked: list[dict]) -> str:
         lost = [r["impulse_n_s"] for r in picked if not r["survived"][last]]
-        return (f"| {label} | {len(picked)} | " + " | ".join(str(sum(r["survived"][f] for r in picked)) for f in feedbacks)
-                + f" | {f'{min(lost):.2f}' if lost else '-'} |")
+        counts = " | ".join(str(sum(r["survived"][f] for r in picked)) for f in feedbacks)
+        return f"| {label} | {len(picked)} | {counts} | {f'{min(lost):.2f}' if lost else '-'} |"
 
     for kind in NEEDS:
         picked = [r for r in found if need(r) == kind]

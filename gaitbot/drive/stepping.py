@@ -7,8 +7,9 @@ as the live drive queues its steps, early enough for the walker's preview to see
 DCM with the plan's; if it left what the ankles hold, the step's foothold moves toward it (within ``[steer]``
 limits and the soles' gap). Until that step starts, a push felt later moves it again (``_redecide``: the walker
 takes it back and it is queued to the new foothold). The steps after a moved one keep their planned length
-from the foot they follow and their side's distance from it. Every goal then goes through the session's Feedback, which keeps it
-inside every joint's position, velocity and acceleration limits (``gaitbot check`` holds it).
+from the foot they follow and their side's distance from it. Every goal then goes through the session's
+Feedback, which keeps it inside every joint's position, velocity and acceleration limits (``gaitbot check``
+holds it).
 
 ``--feedback zmp`` walks the same way without moving footholds (``stepping=False``): instead, before each frame,
 the CoM error the IMU measured (z_c x tilt, at z_c x tilt rate, turned into the walk's world) feeds the preview
