@@ -35,6 +35,9 @@ NUDGE = 1e-10
 SITECUSTOMIZE = f"""
 import os
 if os.environ.get("GAITBOT_NUDGE_SEED"):
+    # the GL backend gaitbot.sim picks, before mujoco is imported: without it mujoco loads GLFW, whose probe
+    # starts a Python process that runs this file again, and so on without end
+    os.environ.setdefault("MUJOCO_GL", "egl")
     import numpy as np
     import mujoco
     _rng = np.random.default_rng(int(os.environ["GAITBOT_NUDGE_SEED"]))
