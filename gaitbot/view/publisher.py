@@ -128,16 +128,6 @@ class BackgroundPublisher:
                 if len(self.publisher.notes) < 10:
                     self.publisher.notes.append(f"telemetry: a frame at {frame.t_s:.2f} s was not written: {exc}")
 
-    def _static_asked(self) -> bool:
-        """A live sink's new client subscribed to a static channel (its ``static_wanted`` event), now taken."""
-        asked = False
-        for sink in self.sinks:
-            wanted = getattr(sink, "static_wanted", None)
-            if wanted is not None and wanted.is_set():
-                wanted.clear()
-                asked = True
-        return asked
-
     def on_frame(self, frame: FrameTelemetry) -> None:
         if self._closed:
             return
