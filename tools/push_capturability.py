@@ -422,9 +422,10 @@ def relaxations_of(state: PlannedState, box: StepBox, reach: bool) -> dict:
 
 
 def draws(pushes: int, seed: int, max_impulse: float) -> list[tuple[float, float, float]]:
-    """tools/push_survival.py's pushes: (impulse N s, direction deg, phase), drawn in the same order."""
-    rng = np.random.default_rng(seed)
-    return [(rng.uniform(0, max_impulse), rng.uniform(0, 360), rng.uniform(0, 1)) for _ in range(pushes)]
+    """tools/push_survival.py's pushes: (impulse N s, direction deg, phase), the same draws."""
+    from push_survival import drawn_pushes
+
+    return drawn_pushes(pushes, seed, max_impulse)
 
 
 def push_time_s(state: PlannedState, phase: float) -> float:

@@ -38,6 +38,12 @@ from gaitbot.app.cli import main
 WALKS = {"op3": "--distance 1 --cycle 0.8 --max-step 0.06", "bioloid": "--distance 0.8 --cycle 0.8 --max-step 0.04"}
 
 
+def drawn_pushes(pushes: int, seed: int, max_impulse: float) -> list[tuple[float, float, float]]:
+    """The pushes (impulse N s, direction deg, phase), drawn from the seeded generator (module docstring)."""
+    rng = np.random.default_rng(seed)
+    return [(rng.uniform(0, max_impulse), rng.uniform(0, 360), rng.uniform(0, 1)) for _ in range(pushes)]
+
+
 def one_push(robot: str, walk: str, impulse: float, direction: float, phase: float, seed: int, feedback: str) -> dict:
     """One simulated walk with one push; the row of the table."""
     out, err = io.StringIO(), io.StringIO()
@@ -57,8 +63,7 @@ def one_push(robot: str, walk: str, impulse: float, direction: float, phase: flo
 
 def markdown(args) -> str:
     """The figure of docs/feedback.md: how many of the pushes in each quarter of 0..max impulse survived."""
-    rng = np.random.default_rng(args.seed)
-    draws = [(rng.uniform(0, args.max_impulse), rng.uniform(0, 360), rng.uniform(0, 1)) for _ in range(args.pushes)]
+    draws = drawn_pushes(args.pushes, args.seed, args.max_impulse)
     modes = args.modes.split(",")
     edges = np.linspace(0, args.max_impulse, 5)
     counts = np.zeros((4, 1 + len(modes)), dtype=int)
@@ -110,8 +115,7 @@ def main_(argv=None) -> int:
     if args.markdown:
         print(markdown(args))
         return 0
-    rng = np.random.default_rng(args.seed)
-    draws = [(rng.uniform(0, args.max_impulse), rng.uniform(0, 360), rng.uniform(0, 1)) for _ in range(args.pushes)]
+    draws = drawn_pushes(args.pushes, args.seed, args.max_impulse)
     modes = args.modes.split(",")
     survived = {m: 0 for m in modes}
     if not args.json:
