@@ -56,6 +56,38 @@ def test_a_still_tilted_torso_is_estimated_from_gravity_and_a_gyro_bias_errs_by_
     assert est.direction() == "forwards"
 
 
+def true_up_in_torso(rotation) -> np.ndarray:
+    """The world's up in the torso's frame for a torso at ``rotation`` (scipy Rotation: torso -> world)."""
+    return rotation.inv().apply([0.0, 0.0, 1.0])
+
+
+def test_a_torso_that_twists_while_it_leans_is_followed_as_a_rotation():
+    # A fall as the simulation shows them: leaning 20 deg to the right, the torso pitches forward at 120 deg/s
+    # while it yaws at -130 deg/s (body rates). The truth is integrated by scipy's rotations, independently.
+    from scipy.spatial.transform import Rotation
+    est = TiltEstimate(PERIOD_S)
+    pose = Rotation.from_euler("x", 20.0, degrees=True)
+    rates_dps = np.array([0.0, 120.0, -130.0])
+    est.update(reading([0.0, 0.0, 0.0], true_up_in_torso(pose)))
+    for _ in range(20):  # a third of a second; the accelerometer reads 1 g along the true up (no lag from it)
+        pose = pose * Rotation.from_rotvec(np.radians(rates_dps) * PERIOD_S)
+        est.update(reading(rates_dps, true_up_in_torso(pose)))
+    truth = math.degrees(math.acos(true_up_in_torso(pose)[2]))
+    assert truth > 40.0  # it fell past the op3's threshold
+    assert est.tilt_deg == pytest.approx(truth, abs=0.5)
+
+
+def test_a_falling_robots_accelerometer_does_not_pull_the_tilt_back():
+    # Near free fall the specific force is small and says nothing of up: the gyro's 100 deg/s for 0.3 s is
+    # the tilt (30 deg), not the 0.2 g that still points along the torso's z.
+    est = TiltEstimate(PERIOD_S)
+    est.update(reading([0.0, 0.0, 0.0]))
+    for _ in range(18):
+        est.update(reading([0.0, 100.0, 0.0], [0.0, 0.0, 0.2]))
+    assert est.pitch_deg == pytest.approx(30.0, abs=0.01)
+    assert est.tilt_deg == pytest.approx(30.0, abs=0.01)
+
+
 def stance_torso_pitch_roll(cfg, angles_by_name: dict, side: str) -> tuple[float, float]:
     """The torso's world pitch and roll (deg) when ``side``'s foot is flat on the floor (gaitbot's kinematics)."""
     q = [angles_by_name[f"{k}_{side}"] for k in ("hip_yaw", "hip_roll", "hip_pitch", "knee_pitch", "ankle_pitch",
