@@ -9,7 +9,8 @@ limit window. Three lines: the feedback alone (--frames frames of a sway), and t
 really does, the online balanced walker's ``next_frame`` (30 steps queued, as tools/bench_balance.py) with the
 feedback on its goals; and ``--feedback zmp``'s CoM correction alone (its support polygon and one step). Both in wall time and in CPU time of this thread (time.thread_time): on a shared machine
 the wall p99 is the host's scheduling, the CPU p99 is the code's. Last, ``--feedback step``'s frames by what
-they do (queue a step, queue a queued step again after a push, neither), in CPU time.
+they do (queue a step, queue a queued step again after a push, take it back for a pause, none of these), in
+CPU time.
 """
 
 from __future__ import annotations
@@ -130,18 +131,19 @@ class LeaningFrom:
 def stepping_frames(config, repeats: int = 5) -> list[str]:
     """``--feedback step``'s frames (gaitbot.drive.stepping) of six 6 cm steps with a lean felt from frame
     110: the frames that queue a step (its capture decision and whole step check), the frames that take a
-    queued step back and queue it again, and the others; CPU time of the thread."""
+    queued step back and queue it again, those that take it back for a pause, and the others; CPU time of the
+    thread."""
     from gaitbot.drive.stepping import SteppingFrames
     from gaitbot.robot.balanced_walk import balanced_gait_settings, plan_balanced
 
     plan = plan_balanced(config, [0.06] * 6, balanced_gait_settings(config, cycle_s=0.8, max_step_m=0.06))
-    cpu: dict[str, list[float]] = {"queue a step": [], "queue a step again": [], "other": []}
+    cpu: dict[str, list[float]] = {"queue a step": [], "queue a step again": [], "pause": [], "other": []}
     for _ in range(repeats):
         felt = LeaningFrom(110)
         frames = SteppingFrames(config, plan, felt)
         frames_iter = iter(frames)
         while True:
-            steps, moved = frames.log.steps, len(frames.log.moved)
+            steps, moved, paused = frames.log.steps, len(frames.log.moved), len(frames.log.paused_s)
             c = time.thread_time()
             try:
                 next(frames_iter)
@@ -149,11 +151,14 @@ def stepping_frames(config, repeats: int = 5) -> list[str]:
                 break
             took = time.thread_time() - c
             again = len(frames.log.moved) > moved and frames.log.moved[-1][2]
-            kind = "queue a step" if frames.log.steps > steps else "queue a step again" if again else "other"
+            if len(frames.log.paused_s) > paused:
+                kind = "pause"
+            else:
+                kind = "queue a step" if frames.log.steps > steps else "queue a step again" if again else "other"
             cpu[kind].append(took)
             felt.tick()
     return [f"--feedback step, {kind}: CPU p50 {np.median(v) * 1e3:.2f} ms, max {max(v) * 1e3:.2f} ms over "
-            f"{len(v)} frames" for kind, v in cpu.items()]
+            f"{len(v)} frames" for kind, v in cpu.items() if v]
 
 
 def main() -> None:

@@ -154,6 +154,7 @@ def run(args) -> int:
         print(f"note: {note}", file=sys.stderr)
     if sim is not None and stepping is not None and stepping.stepping:
         sim.extra["capture_steps"] = stepping.log.summary()
+        sim.extra["capture_pauses_s"] = [round(t_s, 4) for t_s in stepping.log.paused_s]
     if sim is not None and stepping is not None and stepping.correction is not None:
         sim.extra["zmp_correction"] = stepping.correction_log.summary()
     return _report(args, config, walk, result, sim, port, clock, health, feedback)

@@ -6,7 +6,11 @@ plan's frames), each appended DECIDE_FRAMES frames before its double support sta
 as the live drive queues its steps, early enough for the walker's preview to see the step coming. At that moment gaitbot.feel.capture compares the measured
 DCM with the plan's; if it left what the ankles hold, the step's foothold moves toward it (within ``[steer]``
 limits and the soles' gap). Until that step starts, a push felt later moves it again (``_redecide``: the walker
-takes it back and it is queued to the new foothold). The steps after a moved one keep their planned length
+takes it back and it is queued to the new foothold). When the error leans toward the foot that step would
+lift, so that standing on the other foot would leave the DCM further outside it, the step waits instead
+(``_pause``): it is taken back, both feet stay down for PAUSE_FRAMES with the ZMP between them, and it is
+queued again before the pause ends, its weight shifted over a whole step as a walk's first step's is. The
+steps after a moved one keep their planned length
 from the foot they follow and their side's distance from it. Every goal then goes through the session's
 Feedback, which keeps it inside every joint's position, velocity and acceleration limits (``gaitbot check``
 holds it).
@@ -42,6 +46,15 @@ python tools/push_survival.py --modes step; docs/feedback.md)."""
 REDECIDE_M = 0.01
 """A step queued but not started is moved again when the DCM's error asks for a foothold this far (m) from the
 one it was given: a push felt after the step was queued is answered by it, not by the step after it."""
+PAUSE_FRAMES = 48
+"""Frames both feet stay down when a push leans the robot over the foot about to lift (0.8 s at 60 Hz)."""
+PAUSE_HOLD = 0.7
+"""A pause is taken when the DCM's error toward the foot about to lift passes this multiple of the sideways hold
+(HOLD_SHARE's ellipse, sideways: 2.2 cm on the op3). On python tools/push_survival.py's pushes, seeds 23, 24
+and 25, ``step`` survived 163 of 300 without pauses, 173 with 1.0 and 175 with 0.7 (before the tilt estimate's
+spin gating; 181 with it: docs/push-stepping.md)."""
+MAX_PAUSES = 2
+"""Pauses in a row before the step is taken whatever the error."""
 CHECK_TRIES = 3
 """A moved step refused by the step check is tried at half the move, then at a quarter; then the plan's."""
 
@@ -77,6 +90,7 @@ class SteppingLog:
     moved: list[tuple[float, CaptureStep, bool]] = field(default_factory=list)
     steps: int = 0
     refused: int = 0
+    paused_s: list[float] = field(default_factory=list)
 
     def summary(self) -> list[dict]:
         """The moved steps for ``--json``: when decided (s of the walk), the DCM's error and the move (m)."""
@@ -129,6 +143,8 @@ class SteppingFrames:
         self.rate_hz = self.walker.rate_hz
         self.log = SteppingLog()
         self._queued: QueuedStep | None = None  # the step appended last (moved again by _redecide)
+        self._pauses = 0  # pauses in a row before the queued step
+        self._resume_frame = 0  # the walk frame where the last pause ends
         self._next = 0
         self._frames = len(plan.walk.t_s)
         self._append_due()  # the first step: before the walk starts, as the plan has it
@@ -140,7 +156,7 @@ class SteppingFrames:
         return self
 
     def __next__(self) -> np.ndarray:
-        if not self._append_due() and not self._redecide():
+        if not self._append_due() and not self._pause() and not self._redecide():
             self.walker.work()  # a share of the last append's replan, as the drive does (BalancedWalker.work)
         if self.correction is not None:
             self._correct()
@@ -186,6 +202,35 @@ class SteppingFrames:
             return queued.planned
         self.log.moved.append((self.walker._out / self.rate_hz, decision, requeued))
         return decision.foothold
+
+    def _pause(self) -> bool:
+        """The step queued last, not started yet, taken back and a pause of PAUSE_FRAMES queued instead when the
+        DCM's error leans toward the foot it would lift (beyond PAUSE_HOLD x the sideways hold): standing on
+        the other foot would leave the DCM further outside it. The step is queued again before the pause
+        ends. Whether it did."""
+        queued, walker = self._queued, self.walker
+        if queued is None:
+            return False
+        if not walker.last_step_unstarted:
+            self._pauses = 0  # the step after the pauses has started
+            return False
+        e = self.estimate
+        if self._pauses >= MAX_PAUSES or not (self.stepping and self.active() and e.started):
+            return False
+        error = dcm_error_m(e.roll_deg, e.pitch_deg, float(e.rates_dps[0]), float(e.rates_dps[1]),
+                            walker.com_height_m)
+        if error[1] * SIDE_SIGN[queued.planned.side] < PAUSE_HOLD * self.capture.hold_y_m:
+            return False
+        walker.retract_last_step()
+        walker.append_pause(PAUSE_FRAMES, spread=True)
+        self._queued = None
+        self._next -= 1
+        self.log.steps -= 1
+        self._pauses += 1
+        self.log.paused_s.append(walker._out / self.rate_hz)
+        self._resume_frame = walker.rise_frames + walker.planned_frames
+        self._frames += PAUSE_FRAMES  # (a progress bar's total: the slower weight shift after it is not counted)
+        return True
 
     def _redecide(self) -> bool:
         """The step queued last, not started yet, moved again when the DCM's error now asks for a foothold
@@ -249,7 +294,7 @@ class SteppingFrames:
         walker = self.walker
         if not walker.planned_steps:
             return 0
-        return round(walker.planned_steps[-1].end_s * self.rate_hz)
+        return max(round(walker.planned_steps[-1].end_s * self.rate_hz), self._resume_frame)
 
     def _decide(self, stance, swing_from, planned) -> CaptureStep | None:
         e = self.estimate

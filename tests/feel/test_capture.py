@@ -116,7 +116,8 @@ def test_nothing_felt_walks_the_plan_and_a_felt_push_left_moves_a_foothold_left(
 
 
 class FeltFrom(Felt):
-    """Nothing felt until frame ``frame`` of the walk, then a lean to the left (a push felt mid-walk)."""
+    """Nothing felt until frame ``frame`` of the walk, then a lean backward (a push felt mid-walk; a lean toward
+    a foot about to lift would pause the walk instead: the next test)."""
 
     def __init__(self, frame):
         super().__init__()
@@ -125,7 +126,7 @@ class FeltFrom(Felt):
     def tick(self):
         self.frames += 1
         if self.frames >= self.frame:
-            self.roll_deg, self.rates_dps = -4.0, np.array([-30.0, 0.0, 0.0])
+            self.pitch_deg, self.rates_dps = -6.0, np.array([0.0, -45.0, 0.0])
 
 
 def test_a_push_felt_after_a_step_was_queued_moves_that_step_before_it_starts(op3_plan):
@@ -148,7 +149,30 @@ def test_a_push_felt_after_a_step_was_queued_moves_that_step_before_it_starts(op
     t_s, step, again = after[0]
     assert again, "the first move after the push was felt waited for a new step"
     assert t_s <= (felt_frame + 1) / pushed.rate_hz  # at once
-    assert step.moved_m[1] > 0.005 and step.error_m[1] > 0  # to the left, where the push went
+    assert step.moved_m[0] < -0.005 and step.error_m[0] < 0  # backward, where the push went
+
+
+def test_a_lean_toward_the_foot_about_to_lift_pauses_on_both_feet_and_one_away_does_not(op3_plan):
+    """A lean left (the DCM's error to the left) takes back a queued step of the left foot and stands on both
+    feet for PAUSE_FRAMES instead, at most MAX_PAUSES in a row; the walk is then that much longer. A lean
+    right pauses only before right steps, never before left ones."""
+    from gaitbot.drive.stepping import MAX_PAUSES, PAUSE_FRAMES, SteppingFrames
+
+    cfg, plan = op3_plan
+    quiet = SteppingFrames(cfg, plan, Felt(started=False))
+    n_quiet = len(list(quiet))
+    assert not quiet.log.paused_s
+    for roll_deg, side in ((-4.0, "left"), (4.0, "right")):
+        leaning = SteppingFrames(cfg, plan, Felt(roll_deg=roll_deg, rates=(roll_deg * 7.5, 0.0, 0.0)))
+        frames = list(leaning)
+        pauses = leaning.log.paused_s
+        assert pauses
+        assert len(frames) >= n_quiet + PAUSE_FRAMES * len(pauses)  # (and the slower weight shift after one)
+        steps = leaning.walker.planned_steps
+        for t_s in pauses:  # the step that starts next after each pause lifts the foot the lean is toward
+            assert next(s for s in steps if s.start_s > t_s).leg == side
+        in_a_row = [sum(1 for u in pauses if t_s <= u < t_s + (MAX_PAUSES + 1) * PAUSE_FRAMES / 60) for t_s in pauses]
+        assert max(in_a_row) <= MAX_PAUSES
 
 
 @pytest.mark.parametrize("argv, words", [

@@ -91,6 +91,17 @@ def test_twenty_minutes_of_walking_hold_bounded_memory():
 
 
 
+def walking_forward(steps: int):
+    """A walker leading with the left foot with ``steps`` forward steps queued, and the planner that planned them."""
+    walker = balanced_walker(OP3, GAIT)
+    walker.lead_with("left")
+    planner = footstep_planner(OP3, GAIT)
+    for _ in range(steps):
+        step = planner.next_step(COMMANDS[0], walker.next_swing_side)
+        walker.append_footstep(step.foothold, step.length_m)
+    return walker, planner
+
+
 def test_a_step_taken_back_and_appended_elsewhere_plans_as_if_appended_there_at_once():
     """BalancedWalker.retract_last_step (a push felt after a step was queued, gaitbot.drive.stepping): the plan
     after taking back a queued step and appending another foothold is exactly the plan of a walker that was
@@ -99,12 +110,7 @@ def test_a_step_taken_back_and_appended_elsewhere_plans_as_if_appended_there_at_
     from gaitbot.gait.balance.zmp_reference import FootPlacement
 
     def walked_to(first_side_offset_m: float, retract_to_m: float | None):
-        walker = balanced_walker(OP3, GAIT)
-        walker.lead_with("left")
-        planner = footstep_planner(OP3, GAIT)
-        for n in range(3):
-            step = planner.next_step(COMMANDS[0], walker.next_swing_side)
-            walker.append_footstep(step.foothold, step.length_m)
+        walker, _ = walking_forward(3)
         for _ in range(walker.rise_frames + 30):
             walker.next_frame()
         stance = walker.feet["left" if walker.next_swing_side == "right" else "right"]
@@ -139,3 +145,39 @@ def test_a_step_taken_back_and_appended_elsewhere_plans_as_if_appended_there_at_
             frames.append(frame[1])
         ends.append(np.array(frames[-60:]))
     assert np.abs(ends[0] - ends[1]).max() < 1e-6
+
+
+def test_a_pause_stands_on_both_feet_with_the_zmp_between_them_and_the_next_step_shifts_its_weight_slowly():
+    """BalancedWalker.append_pause (a push that lifting the next foot would make worse, gaitbot.drive.stepping):
+    for its frames both feet stay where they stand and neither swings, the ZMP reference ends between the
+    soles' centres and the weight half on each foot; the step after it takes a whole step's frames to move
+    the ZMP onto its stance foot, as a walk's first step does, where one after a step takes the short
+    double support."""
+    from gaitbot.gait.balance.zmp_reference import standing_zmp
+
+    def walker_after(pause_frames: int):
+        walker, planner = walking_forward(2)
+        before = walker.planned_frames
+        feet = walker.feet
+        if pause_frames:
+            walker.append_pause(pause_frames)
+        paused = walker.planned_frames
+        step = planner.next_step(COMMANDS[0], walker.next_swing_side)
+        walker.append_footstep(step.foothold, step.length_m)
+        return walker, feet, before, paused
+
+    walker, feet, before, paused = walker_after(48)
+    a = walker.plan_arrays()
+    assert paused - before == 48
+    pause = slice(before, paused)
+    assert not a["swinging"][pause].any()
+    expected_ankles = [[feet[s].x_m, feet[s].y_m, OP3.body.geometry.ankle_height_m] for s in ("left", "right")]
+    np.testing.assert_allclose(a["ankles"][pause], np.broadcast_to(expected_ankles, (48, 2, 3)))
+    np.testing.assert_allclose(a["zmp"][paused - 1], standing_zmp(OP3.body.geometry, feet["left"], feet["right"]))
+    assert a["share_left"][paused - 1] == pytest.approx(0.5)
+    # the step after: double support (nothing swings) for a whole step's frames, then its swing
+    after = a["swinging"][paused:]
+    timing = walker.timing
+    assert np.flatnonzero(after)[0] == timing.step_frames
+    unpaused, _, before_b, _ = walker_after(0)
+    assert np.flatnonzero(unpaused.plan_arrays()["swinging"][before_b:])[0] == timing.ds_frames

@@ -38,11 +38,26 @@ def test_a_sideways_push_moves_a_foothold_its_way_and_the_recording_checks(tmp_p
     assert run_cli(capsys, "check", record)[0] == 0
 
 
+def test_a_push_toward_the_foot_about_to_lift_pauses_the_walk_and_the_recording_checks(tmp_path, capsys):
+    # pushed to the right in the left foot's swing: the right foot, queued to lift next, would leave the robot
+    # on its left foot with the push carrying it further right; the walk waits on both feet instead
+    record = tmp_path / "paused.jsonl"
+    code, out, err = run_cli(capsys, *WALK, "--feedback", "step", "--push", "1.0@270", "--record", record)
+    assert code in (0, 1), err
+    report = json.loads(out)
+    push = report["push"]
+    assert push["leg"] == "left"
+    pauses = report["capture_pauses_s"]
+    assert pauses and push["start_s"] < pauses[0] < push["start_s"] + 0.25  # felt and answered at once
+    assert len(pauses) <= 2  # stepping.MAX_PAUSES in a row
+    assert run_cli(capsys, "check", record)[0] == 0
+
+
 def test_without_a_push_nothing_moves_and_other_modes_report_no_steps(capsys):
     code, out, err = run_cli(capsys, *WALK, "--feedback", "step")
     assert code == 0, err
     report = json.loads(out)
-    assert report["capture_steps"] == [] and not report["fell"]
+    assert report["capture_steps"] == [] and report["capture_pauses_s"] == [] and not report["fell"]
     code, out, err = run_cli(capsys, *WALK, "--feedback", "full")
     assert "capture_steps" not in json.loads(out)
 

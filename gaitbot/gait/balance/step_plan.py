@@ -88,6 +88,7 @@ class PlanState:
     share_left: float = 0.5
     steps: int = 0
     last_length_m: float = 0.0
+    paused: bool = False  # both feet stood still since the last step: the next one shifts its weight slowly
 
     def copy(self) -> "PlanState":
         return replace(self, feet=dict(self.feet), zmp_now=self.zmp_now.copy())
@@ -218,7 +219,8 @@ class StepPlanner:
             raise ValueError(f"the next step is the {swing_side} foot's, not the {new.side} foot's")
         stance, old = state.feet[stance_side], state.feet[swing_side]
         feet_ankles, feet_cops, feet_yaw = self.ankles(state.feet), self.cops(state.feet), self.yaws(state.feet)
-        n_ds = t.step_frames if state.steps == 0 else t.ds_frames  # the first: the weight shift
+        # the first, or the first after a pause: the weight shift
+        n_ds = t.step_frames if state.steps == 0 or state.paused else t.ds_frames
         target = zmp_point(g, b, stance)
         zmp, w = shift(state.zmp_now, target, n_ds)
         share_target = 1.0 if stance_side == "left" else 0.0
@@ -251,7 +253,21 @@ class StepPlanner:
         state.stance_next = swing_side
         state.steps += 1
         state.last_length_m = length_m
+        state.paused = False
         return Landing(blocks.frames - 1, swing_side, new.x_m, new.y_m, length_m, start_frame, new.yaw_rad)
+
+    def pause(self, blocks: PlanBlocks, state: PlanState, frames: int) -> None:
+        """Both feet down for ``frames`` frames: the ZMP moves between the feet (over a whole step's frames,
+        or all of them if fewer) and stays; the next step shifts its weight over a whole step, as the first."""
+        middle = standing_zmp(self.geometry, state.feet["left"], state.feet["right"])
+        moving = min(self.timing.step_frames, frames)
+        zmp, w = shift(state.zmp_now, middle, moving)
+        blocks.add(zmp, np.repeat(self.ankles(state.feet)[None], moving, 0), self.walk_root_z,
+                   state.share_left + w * (0.5 - state.share_left), np.repeat(self.cops(state.feet)[None], moving, 0),
+                   0, self.yaws(state.feet))
+        state.zmp_now, state.share_left, state.paused = middle, 0.5, True
+        if frames > moving:
+            self._still(blocks, state, frames - moving, self.walk_root_z)
 
     def partner(self, stance: FootPlacement) -> FootPlacement:
         """The other foot side by side with ``stance``: parallel, ankles hip_width apart."""

@@ -240,6 +240,15 @@ class BalancedWalker(Lookahead):
         del self.planned_steps[steps:]
         self._commit()
 
+    def append_pause(self, frames: int, spread: bool = False) -> None:
+        """Queue ``frames`` frames of standing on both feet (StepPlanner.pause): a push that lifting the next
+        foot would make worse is waited out (gaitbot.drive.stepping). ``spread``: as append_step's."""
+        if self.finished:
+            raise RuntimeError("the walk has already been closed; start a new walker")
+        self.planner.pause(self._blocks, self._state, int(frames))
+        self._appended(spread)
+        self._last_step = None
+
     def _appended(self, spread: bool) -> None:
         if not self._batch:
             self._commit()
