@@ -58,7 +58,16 @@ def one_push(robot: str, walk: str, impulse: float, direction: float, phase: flo
     report = json.loads(out.getvalue())
     return {"impulse_n_s": round(impulse, 3), "direction_deg": round(direction, 1), "phase": round(phase, 6),
             "feedback": feedback, "survived": not report["fell"], "fell_at_s": report["fell_at_s"],
-            "fall_direction": report["fall_direction"]}
+            "fall_direction": report["fall_direction"], "noticed_after_s": noticed_after_s(report)}
+
+
+def noticed_after_s(report: dict) -> float | None:
+    """How long after the simulated torso's true tilt crossed the fall threshold the IMU noticed the fall (s),
+    or None (no fall noticed)."""
+    fall = report.get("fall_noticed")
+    if not fall or fall.get("true_tilt_crossed_s") is None:
+        return None
+    return round(fall["t_s"] - fall["true_tilt_crossed_s"], 4)
 
 
 def markdown(args) -> str:
@@ -68,12 +77,16 @@ def markdown(args) -> str:
     edges = np.linspace(0, args.max_impulse, 5)
     counts = np.zeros((4, 1 + len(modes)), dtype=int)
     survived = {m: [] for m in modes}
+    noticed = {m: [] for m in modes}
     for n, (impulse, direction, phase) in enumerate(draws, start=1):
         quarter = min(int(impulse / args.max_impulse * 4), 3)
         counts[quarter, 0] += 1
         for i, m in enumerate(modes):
-            survived[m].append(one_push(args.robot, WALKS[args.robot], impulse, direction, phase, n, m)["survived"])
-            counts[quarter, 1 + i] += survived[m][-1]
+            row = one_push(args.robot, WALKS[args.robot], impulse, direction, phase, n, m)
+            survived[m].append(row["survived"])
+            counts[quarter, 1 + i] += row["survived"]
+            if row["noticed_after_s"] is not None:
+                noticed[m].append(row["noticed_after_s"])
     rows = ["| impulse N s | pushes | " + " | ".join(f"survived, feedback {m}" for m in modes) + " |",
             "|---|---|" + "---|" * len(modes)]
     for q in range(4):
@@ -82,7 +95,14 @@ def markdown(args) -> str:
     rows.append(f"| all | {counts[:, 0].sum()} | " + " | ".join(str(c) for c in counts[:, 1:].sum(axis=0)) + " |")
     name = f"push-{args.robot}" + "".join(f"-{m}" for m in ("step", "zmp") if m in modes)
     return (f"<!-- figure {name} -->\n" + "\n".join(rows) + "\n<!-- /figure -->\n"
-            f"<!-- figure {name}-by-way -->\n" + by_way(draws, survived, modes) + "\n<!-- /figure -->")
+            f"<!-- figure {name}-by-way -->\n" + by_way(draws, survived, modes) + "\n<!-- /figure -->\n"
+            f"<!-- figure {name}-noticed -->\n" + noticed_lines(noticed) + "\n<!-- /figure -->")
+
+
+def noticed_lines(noticed: dict) -> str:
+    """How long after the true tilt crossed the fall threshold the IMU noticed each fall, per mode."""
+    return "\n".join(f"feedback {m}: {len(v)} falls noticed by the IMU, {min(v) * 1e3:.0f} to {max(v) * 1e3:.0f} ms "
+                     f"after the true tilt crossed the threshold" for m, v in noticed.items() if v)
 
 
 WAYS = ("forwards", "to the left", "backwards", "to the right")
@@ -118,6 +138,7 @@ def main_(argv=None) -> int:
     draws = drawn_pushes(args.pushes, args.seed, args.max_impulse)
     modes = args.modes.split(",")
     survived = {m: 0 for m in modes}
+    noticed = {m: [] for m in modes}
     if not args.json:
         print("| push | impulse N s | direction deg | phase | " + " | ".join(f"survived ({m})" for m in modes) + " |")
         print("|---|---|---|---|" + "---|" * len(modes))
@@ -125,6 +146,8 @@ def main_(argv=None) -> int:
         rows = [one_push(args.robot, WALKS[args.robot], impulse, direction, phase, n, m) for m in modes]
         for row in rows:
             survived[row["feedback"]] += row["survived"]
+            if row["noticed_after_s"] is not None:
+                noticed[row["feedback"]].append(row["noticed_after_s"])
             if args.json:
                 print(json.dumps(row))
         if not args.json:
@@ -133,6 +156,7 @@ def main_(argv=None) -> int:
     if not args.json:
         print(f"\n{args.robot}, {args.pushes} pushes of 0..{args.max_impulse:g} N s (seed {args.seed}): "
               + "; ".join(f"feedback {m}: {survived[m]} survived" for m in modes))
+        print(noticed_lines(noticed))
     return 0
 
 
