@@ -214,12 +214,8 @@ class SteppingFrames:
         if not walker.last_step_unstarted:
             self._pauses = 0  # the step after the pauses has started
             return False
-        e = self.estimate
-        if self._pauses >= MAX_PAUSES or not (self.stepping and self.active() and e.started):
-            return False
-        error = dcm_error_m(e.roll_deg, e.pitch_deg, float(e.rates_dps[0]), float(e.rates_dps[1]),
-                            walker.com_height_m)
-        if error[1] * SIDE_SIGN[queued.planned.side] < PAUSE_HOLD * self.capture.hold_y_m:
+        error = self._dcm_error_m() if self._pauses < MAX_PAUSES else None
+        if error is None or error[1] * SIDE_SIGN[queued.planned.side] < PAUSE_HOLD * self.capture.hold_y_m:
             return False
         walker.retract_last_step()
         walker.append_pause(PAUSE_FRAMES, spread=True)
@@ -297,9 +293,14 @@ class SteppingFrames:
         return max(round(walker.planned_steps[-1].end_s * self.rate_hz), self._resume_frame)
 
     def _decide(self, stance, swing_from, planned) -> CaptureStep | None:
+        error = self._dcm_error_m()
+        return None if error is None else self.capture.decide(error, stance, swing_from, planned)
+
+    def _dcm_error_m(self) -> tuple[float, float] | None:
+        """The DCM's error the IMU measures (gaitbot.feel.capture.dcm_error_m), or None when not stepping or
+        the IMU is not to be trusted."""
         e = self.estimate
         if not (self.stepping and self.active() and e.started):
             return None
-        error = dcm_error_m(e.roll_deg, e.pitch_deg, float(e.rates_dps[0]), float(e.rates_dps[1]),
-                            self.walker.com_height_m)
-        return self.capture.decide(error, stance, swing_from, planned)
+        return dcm_error_m(e.roll_deg, e.pitch_deg, float(e.rates_dps[0]), float(e.rates_dps[1]),
+                           self.walker.com_height_m)

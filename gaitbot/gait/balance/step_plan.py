@@ -259,15 +259,20 @@ class StepPlanner:
     def pause(self, blocks: PlanBlocks, state: PlanState, frames: int) -> None:
         """Both feet down for ``frames`` frames: the ZMP moves between the feet (over a whole step's frames,
         or all of them if fewer) and stays; the next step shifts its weight over a whole step, as the first."""
-        middle = standing_zmp(self.geometry, state.feet["left"], state.feet["right"])
         moving = min(self.timing.step_frames, frames)
-        zmp, w = shift(state.zmp_now, middle, moving)
-        blocks.add(zmp, np.repeat(self.ankles(state.feet)[None], moving, 0), self.walk_root_z,
-                   state.share_left + w * (0.5 - state.share_left), np.repeat(self.cops(state.feet)[None], moving, 0),
-                   0, self.yaws(state.feet))
-        state.zmp_now, state.share_left, state.paused = middle, 0.5, True
+        self._weight_to_both_feet(blocks, state, moving)
+        state.paused = True
         if frames > moving:
             self._still(blocks, state, frames - moving, self.walk_root_z)
+
+    def _weight_to_both_feet(self, blocks: PlanBlocks, state: PlanState, frames: int) -> None:
+        """Both feet still while the ZMP moves between them and the weight to half on each, over ``frames``."""
+        middle = standing_zmp(self.geometry, state.feet["left"], state.feet["right"])
+        zmp, w = shift(state.zmp_now, middle, frames)
+        blocks.add(zmp, np.repeat(self.ankles(state.feet)[None], frames, 0), self.walk_root_z,
+                   state.share_left + w * (0.5 - state.share_left), np.repeat(self.cops(state.feet)[None], frames, 0),
+                   0, self.yaws(state.feet))
+        state.zmp_now, state.share_left = middle, 0.5
 
     def partner(self, stance: FootPlacement) -> FootPlacement:
         """The other foot side by side with ``stance``: parallel, ankles hip_width apart."""
@@ -292,13 +297,7 @@ class StepPlanner:
             landings.append(self.step(blocks, state, 0.0))
         elif turned and (state.steps == 0 or not self.side_by_side(state)):
             landings.append(self.step_to(blocks, state, self.partner(state.feet[state.stance_next]), 0.0))
-        middle = standing_zmp(self.geometry, state.feet["left"], state.feet["right"])
-        zmp, w = shift(state.zmp_now, middle, self.timing.step_frames)
-        n = len(zmp)
-        blocks.add(zmp, np.repeat(self.ankles(state.feet)[None], n, 0), self.walk_root_z,
-                   state.share_left + w * (0.5 - state.share_left), np.repeat(self.cops(state.feet)[None], n, 0), 0,
-                   self.yaws(state.feet))
-        state.zmp_now, state.share_left = middle, 0.5
+        self._weight_to_both_feet(blocks, state, self.timing.step_frames)
         self.hold(blocks, state, END_STAND_S)
         self.settle(blocks, state, bend=False)
         return landings

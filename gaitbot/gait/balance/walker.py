@@ -196,8 +196,7 @@ class BalancedWalker(Lookahead):
     def append_step(self, length_m: float, spread: bool = False) -> None:
         """Queue one step: its foot lands ``length_m`` beyond the previous heel strike. ``spread``: see
         ``work`` (the look-ahead's body placements are redone over the next frames, not at once)."""
-        if self.finished:
-            raise RuntimeError("the walk has already been closed; start a new walker")
+        self._check_open()
         if not (math.isfinite(length_m) and 0.0 <= length_m <= self.gait.max_step_m + STEP_LENGTH_TOLERANCE_M):
             raise BalancedWalkError(f"step length {length_m!r} m is outside 0..{self.gait.max_step_m:g} m")
         self._record(self.planner.step(self._blocks, self._state, float(length_m)), closing=False)
@@ -209,8 +208,7 @@ class BalancedWalker(Lookahead):
         ankle point and yaw, world); ``length_m`` is recorded as the step's length (its forward part).
         The planner (gaitbot.gait.steer.planner) has bounded it and checked the feet's clearance.
         ``spread``: as append_step's."""
-        if self.finished:
-            raise RuntimeError("the walk has already been closed; start a new walker")
+        self._check_open()
         if not all(math.isfinite(v) for v in (foothold.x_m, foothold.y_m, foothold.yaw_rad, length_m)):
             raise BalancedWalkError(f"foothold {foothold!r} is not finite")
         before = (self._state.copy(), self._committed, len(self.heel_strikes), len(self.planned_steps))
@@ -243,11 +241,14 @@ class BalancedWalker(Lookahead):
     def append_pause(self, frames: int, spread: bool = False) -> None:
         """Queue ``frames`` frames of standing on both feet (StepPlanner.pause): a push that lifting the next
         foot would make worse is waited out (gaitbot.drive.stepping). ``spread``: as append_step's."""
-        if self.finished:
-            raise RuntimeError("the walk has already been closed; start a new walker")
+        self._check_open()
         self.planner.pause(self._blocks, self._state, int(frames))
         self._appended(spread)
         self._last_step = None
+
+    def _check_open(self) -> None:
+        if self.finished:
+            raise RuntimeError("the walk has already been closed; start a new walker")
 
     def _appended(self, spread: bool) -> None:
         if not self._batch:
