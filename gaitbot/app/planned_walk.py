@@ -254,12 +254,15 @@ def speed_fit_note(plan: BalancedPlan) -> str | None:
     settings = (f"crouch {b.crouch_knee_deg:g} deg, double support {100 * b.double_support_share:g}%, progression "
                 f"done at {100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm")
     peak = f"peak {fit.peak_dps:.0f} deg/s, {100 * fit.peak_share:.1f}% of a limit"
+    # a foot still travelling when it lands lands short (tools/fast_walks.py: 79% to 93% of the plan's steps)
+    short = ("; with the foot moving until it lands, steps land short of the plan: a longer --cycle with longer "
+             "steps goes further, docs/walk-faster.md" if b.progression_end >= 1.0 else "")
     if not fit.fits:
         return (f"no gentler walk keeps the servos within {100 * fit.target_share:g}% of their velocity and "
                 f"acceleration limits (the margin planned walks keep) at this cycle and step: walking with "
-                f"{settings} ({peak}; a longer --cycle or shorter steps fit; docs/checking.md)")
+                f"{settings} ({peak}; a longer --cycle or shorter steps fit; docs/checking.md){short}")
     return (f"the servos' limits (max_velocity_dps {fit.limit_dps:g}, kept within {100 * fit.target_share:g}%) needed "
-            f"a gentler walk at this cycle and step: {settings} ({peak}; docs/balance.md)")
+            f"a gentler walk at this cycle and step: {settings} ({peak}; docs/balance.md){short}")
 
 
 def terrain_walk(source: GaitSource, course_path: str, clearance_m: float | None = None):
