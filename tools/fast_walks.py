@@ -1,12 +1,12 @@
 """Where a faster walk's steps land, and how soft the servos may be for it (docs/walk-faster.md).
 
-    python tools/fast_walks.py              # the three tables, as text (about 2 minutes on a 2-core machine)
+    python tools/fast_walks.py              # the three tables, as text (about a minute on a 2-core machine)
     python tools/fast_walks.py --markdown   # docs/walk-faster.md's figures (tools/figures.py)
 
 Every walk is ``gaitbot walk --sim --json --robot CONFIG --distance 2 ARGS`` (feedback as the robot's IMU
 allows: full on the op3), run in this process through gaitbot's own command line:
 
-- the op3's walks from the shipped one to 0.2 m/s (WALKS) on gaitbot's own model: the settings the speed fit
+- the op3's walks from the shipped one to 0.2 m/s (``walks``) on gaitbot's own model: the settings the speed fit
   chose for each (gaitbot.gait.balance.speed_fit), the distance travelled and the steps' mean length as
   landed (the heel strikes' spacing) against the plan's;
 - the shipped walk's cycle and step walked with its own settings, with one setting of the speed fit's next
@@ -47,12 +47,8 @@ from gaitbot.robot.config import load_robot_config, resolve_config  # noqa: E402
 OP3 = ROOT / "config" / "op3.toml"
 MENAGERIE_MAP = ROOT / "config" / "sim-maps" / "op3-menagerie.toml"
 DISTANCE_M = 2.0
-WALKS = {"shipped (cycle 1.2 s, 5 cm steps; 0.083 m/s)": (1.2, 0.05),
-         "0.1 m/s (cycle 1.0 s, 5 cm)": (1.0, 0.05),
-         "0.1 m/s (cycle 1.4 s, 7 cm)": (1.4, 0.07),
-         "0.15 m/s (cycle 0.8 s, 6 cm)": (0.8, 0.06),
-         "0.2 m/s (cycle 0.8 s, 8 cm)": (0.8, 0.08)}
-"""The walks: label -> (cycle s, step m)."""
+FASTER = ((1.0, 0.05), (1.4, 0.07), (0.8, 0.06), (0.8, 0.08))
+"""The faster walks, (cycle s, step m): 0.1 m/s two ways, 0.15 and 0.2 m/s; after the shipped one (the config's)."""
 SHIPPED_CANDIDATE = 2
 """The speed fit's candidate the shipped walk takes (gaitbot.gait.balance.speed_fit.candidates; checked)."""
 SINGLE_CHANGES = {"the shipped walk's, progression done at 100%": (0.10, 1.0, 0.005),
@@ -67,6 +63,17 @@ MENAGERIE_VARIANTS = {"as it is (kp 21.1 N m/rad, 5 N m, damping 1.084)": {},
                       "floor friction 0.6": {"friction": 0.6}}
 """Menagerie's OP3 and the changes made to it (its actuators' kp scaled, force limit, joint damping scaled,
 every geom's sliding friction)."""
+
+
+def walks() -> dict[str, tuple[float, float]]:
+    """label -> (cycle s, step m): the op3's shipped walk (its config's ``[gait]``), then FASTER."""
+    gait = load_robot_config(OP3).gait
+    speed = gait.max_step_m / (gait.cycle_s / 2)
+    out = {f"shipped (cycle {gait.cycle_s:g} s, {100 * gait.max_step_m:g} cm steps; {speed:.2g} m/s)":
+           (gait.cycle_s, gait.max_step_m)}
+    for cycle_s, step_m in FASTER:
+        out[f"{step_m / (cycle_s / 2):.2g} m/s (cycle {cycle_s:g} s, {100 * step_m:g} cm)"] = (cycle_s, step_m)
+    return out
 
 
 def sub_once(pattern: str, replacement: str, text: str) -> str:
@@ -134,7 +141,7 @@ def steps_table() -> str:
     config = load_robot_config(resolve_config("op3"))
     lines = ["| walk | settings the speed fit chose | travelled | steps landed / planned | largest slip |",
              "|---|---|---|---|---|"]
-    for label, (cycle_s, step_m) in WALKS.items():
+    for label, (cycle_s, step_m) in walks().items():
         fit = fitted_settings(config, balanced_gait_settings(config, cycle_s=cycle_s, max_step_m=step_m))
         report = walk("op3", cycle_s, step_m)
         lines.append(f"| {label} | {settings_text(fit.balance, fit.gait)} | {outcome(report)} | "
@@ -185,13 +192,14 @@ def _short(label: str) -> str:
 
 def servos_table(folder: Path) -> str:
     """Menagerie's OP3, as it is and changed, at each walk: the distance travelled, or when it fell."""
-    lines = ["| Menagerie's OP3 | " + " | ".join(_short(label) for label in WALKS) + " |",
-             "|---" * (len(WALKS) + 1) + "|"]
+    chosen = walks()
+    lines = ["| Menagerie's OP3 | " + " | ".join(_short(label) for label in chosen) + " |",
+             "|---" * (len(chosen) + 1) + "|"]
     for i, (label, change) in enumerate(MENAGERIE_VARIANTS.items()):
         path = folder / f"menagerie{i}.xml"
         path.write_text(menagerie_variant(**change))
         cells = [outcome(walk("op3", cycle_s, step_m, "--sim-model", str(path), "--sim-map", str(MENAGERIE_MAP)))
-                 for cycle_s, step_m in WALKS.values()]
+                 for cycle_s, step_m in chosen.values()]
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
