@@ -151,16 +151,17 @@ def steps_table() -> str:
 
 def settings_rows(config) -> list[tuple[str, object, object]]:
     """(label, balance, gait): the speed fit's candidate the shipped walk takes (the robot's own values and the
-    next keep no servo margin even at the shipped cycle), SINGLE_CHANGES, the next candidate (the one after it,
-    10 deg deeper, keeps no margin at the shipped cycle either)."""
+    next keep no servo margin even at the shipped cycle), SINGLE_CHANGES, and the first candidate with both
+    at the shipped crouch (the fit's last resort but one; the deeper one keeps no margin at the shipped cycle)."""
     gait = balanced_gait_settings(config)
     found = candidates(gait, config.balance)
     shipped_balance, shipped_gait = found[SHIPPED_CANDIDATE]
     singles = [(label, replace(shipped_balance, double_support_share=ds, progression_end=pe),
                 replace(shipped_gait, clearance_m=cl)) for label, (ds, pe, cl) in SINGLE_CHANGES.items()]
-    after = SHIPPED_CANDIDATE + 1
+    both = next(i for i, (b, g) in enumerate(found) if b.progression_end >= 1.0 and g.clearance_m < shipped_gait.clearance_m
+                and b.crouch_knee_deg == shipped_balance.crouch_knee_deg)
     return [(f"the shipped walk's (the fit's candidate {SHIPPED_CANDIDATE})", shipped_balance, shipped_gait), *singles,
-            (f"the fit's candidate {after} (both, and a shorter double support)", *found[after])]
+            (f"the fit's candidate {both} (both, and a shorter double support)", *found[both])]
 
 
 def settings_table(folder: Path) -> str:
