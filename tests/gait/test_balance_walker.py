@@ -12,14 +12,15 @@ import pytest
 
 from gaitbot.gait.balance.flat_foot_body import FlatFootBody
 from gaitbot.gait.balance.preview import PreviewController, preview_gains, preview_offline
-from gaitbot.gait.balance.speed_fit import fit_to_servo_speed
+from gaitbot.gait.balance.speed_fit import candidates, fit_to_servo_speed
 from gaitbot.gait.balance.walker import BalancedWalkError, generate_balanced_walk
 from gaitbot.gait.joints import LEG_JOINTS, SIDES
 from gaitbot.gait.kinematics6 import foot_pose, leg_ik, rot_y
 from gaitbot.gait.mass import MassModel
-from gaitbot.robot.balanced_walk import (balanced_gait_settings, balanced_walker, leg_limits_rad, plan_balanced,
-                                         servo_stiffness_nm_per_rad)
+from gaitbot.robot.balanced_walk import (balanced_gait_settings, balanced_walker, fitted_settings, leg_limits_rad,
+                                         motion_measure, plan_balanced, servo_stiffness_nm_per_rad, velocity_limit_dps)
 from gaitbot.robot.config import load_robot_config, resolve_config
+from gaitbot.robot.motion_margin import PLANNED_SHARE
 
 OP3 = load_robot_config(resolve_config("op3"))
 GEOMETRY = OP3.body.geometry
@@ -199,6 +200,23 @@ def test_the_speed_fit_relaxes_a_walk_the_servos_cannot_follow():
     assert fit.relaxed > 0 and fit.balance.double_support_share < OP3.balance.double_support_share
     nominal = fit_to_servo_speed(OP3.body, balanced_gait_settings(OP3), OP3.balance, 240.0)
     assert nominal.relaxed == 0 and nominal.fits
+
+
+def test_the_speed_fit_leaves_the_foot_moving_until_it_lands_for_last():
+    """A foot still moving forward when it lands lands short (docs/walk-faster.md), so the candidates whose
+    progression ends with the swing come last, and among candidates asking the same least share the fit keeps
+    the earlier. The 0.15 m/s push walk (cycle 0.8 s, 6 cm), which no candidate fits within the margin, is then
+    walked with its progression done before the swing ends; no later candidate asks less."""
+    gait = balanced_gait_settings(OP3, cycle_s=0.8, max_step_m=0.06)
+    fit = fitted_settings(OP3, gait)
+    assert not fit.fits and fit.balance.progression_end < 1.0
+    found = candidates(gait, OP3.balance)
+    assert [b.progression_end >= 1.0 for b, _ in found] == sorted(b.progression_end >= 1.0 for b, _ in found)
+    options = dict(measure=motion_measure(OP3), share=PLANNED_SHARE, limits_rad=leg_limits_rad(OP3),
+                   kp_nm_per_rad=servo_stiffness_nm_per_rad(OP3))
+    for first in range(fit.relaxed + 1, len(found)):
+        later = fit_to_servo_speed(OP3.body, gait, OP3.balance, velocity_limit_dps(OP3), first=first, **options)
+        assert later.peak_share >= fit.peak_share
 
 
 def test_generate_without_feedforward_sends_the_planned_angles():
