@@ -26,7 +26,6 @@ import argparse
 import contextlib
 import io
 import json
-import re
 import sys
 import tempfile
 from dataclasses import replace
@@ -38,6 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))
 
 import op3_menagerie  # noqa: E402
+from robustness_feedback import sub_once  # noqa: E402
 
 from gaitbot.app.cli import main as gaitbot  # noqa: E402
 from gaitbot.gait.balance.speed_fit import candidates  # noqa: E402
@@ -76,14 +76,6 @@ def walks() -> dict[str, tuple[float, float]]:
     return out
 
 
-def sub_once(pattern: str, replacement: str, text: str) -> str:
-    """``text`` with the one match of ``pattern`` replaced (RuntimeError unless exactly one)."""
-    text, count = re.subn(pattern, replacement, text, count=1, flags=re.M)
-    if count != 1:
-        raise RuntimeError(f"no {pattern!r} to change")
-    return text
-
-
 def menagerie_variant(kp: float = 1.0, force_nm: float = 5.0, damping: float = 1.0, friction: float = 1.0) -> str:
     """Menagerie's OP3 (tools/op3_menagerie.py) with its position servos' kp and the joints' damping scaled,
     the servos' force limit ``force_nm`` and the floor's (every geom's) sliding friction ``friction``."""
@@ -100,7 +92,7 @@ def settings_config(crouch_knee_deg: float, double_support_share: float, progres
     text = OP3.read_text()
     for key, value in (("crouch_knee_deg", crouch_knee_deg), ("double_support_share", double_support_share),
                        ("progression_end", progression_end), ("clearance_m", clearance_m)):
-        text = sub_once(rf"^{key} = .*$", f"{key} = {value!r}", text)
+        text = sub_once(rf"(?m)^{key} = .*$", f"{key} = {value!r}", text)
     return text
 
 

@@ -111,14 +111,16 @@ def session_mjcf(config: RobotConfig, error_deg: float, friction: float = 1.0) -
     rate = config.gait.rate_hz
     drives = tuple(replace(d, full_torque_error_deg=error_deg) for d in joint_drives(config, config.joints))
     text = build_mjcf_3d(config, drives, rate, "free")
-    text = _sub_once(r'timestep="[^"]*"', f'timestep="{1.0 / (rate * substeps_per_frame(rate))!r}"', text)
-    return _sub_once(r'(<default>\s*<geom [^>]*friction=")[^ "]+', rf"\g<1>{friction!r}", text)
+    text = sub_once(r'timestep="[^"]*"', f'timestep="{1.0 / (rate * substeps_per_frame(rate))!r}"', text)
+    return sub_once(r'(<default>\s*<geom [^>]*friction=")[^ "]+', rf"\g<1>{friction!r}", text)
 
 
-def _sub_once(pattern: str, replacement: str, text: str) -> str:
+def sub_once(pattern: str, replacement, text: str) -> str:
+    """``text`` with the one match of ``pattern`` replaced (a string or a function of the match, as re.sub takes;
+    RuntimeError when there is none: the text it edits, a model or a config, changed under the tool)."""
     text, count = re.subn(pattern, replacement, text, count=1)
     if count != 1:
-        raise RuntimeError(f"the model builder's MJCF has no {pattern!r}")
+        raise RuntimeError(f"no {pattern!r} to change")
     return text
 
 

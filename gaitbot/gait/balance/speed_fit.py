@@ -8,11 +8,12 @@ and step (on the OP3 a 15% double support, the progression done at 80% of the sw
 1 / ((1 - double support) x progression_end) and its lift with the clearance, so the candidates are, in
 order: the robot's values; the same 10 deg deeper in the crouch (the bent knee lifts and swings the foot
 with less speed); double support 10% / progression 0.9; 5% / 0.9 / clearance 3 mm, then 10 deg deeper;
-5% / 1.0 / 3 mm, then 10 deg deeper (FALLBACKS); the first whose walk keeps every joint at or under ``share`` of its limits (the robot's planners keep
-PLANNED_SHARE, gaitbot.robot.motion_margin, measured by gaitbot.robot.joint_motion: velocity and
-acceleration of the goal ticks as sent) is used (if none does, the one that asks the least share of a
-limit, the earlier of equals: the limit check then says whether it is still within the limits, which joint, and when). The walk itself is planned for each
-candidate until one fits (an offline walk of 2 m takes ~0.1 s).
+5% / 1.0 / 3 mm, then 10 deg deeper (FALLBACKS). The first whose walk keeps every joint at or under ``share``
+of its limits (the robot's planners keep PLANNED_SHARE, gaitbot.robot.motion_margin, measured by
+gaitbot.robot.joint_motion: velocity and acceleration of the goal ticks as sent) is used; if none does, the
+one that asks the least share of a limit, the earlier of equals (the limit check then says whether it is
+still within the limits, which joint, and when). The walk itself is planned for each candidate until one
+fits (an offline walk of 2 m takes ~0.1 s).
 """
 
 from __future__ import annotations
