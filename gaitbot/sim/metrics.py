@@ -205,6 +205,7 @@ class WalkMeter:
         self.torso_x_m: list[float] = []
         self.torso_y_m: list[float] = []
         self.rpy_deg: list[np.ndarray] = []
+        self.tilt_deg: list[float] = []  # the torso's true tilt from upright, each frame (_tilt_deg)
         self.touch_share: list[np.ndarray] = []
         self.effort: list[float] = []
         self.tracking_deg: list[float] = []
@@ -232,6 +233,7 @@ class WalkMeter:
         self.torso_x_m.append(float(torso[0]))
         self.torso_y_m.append(float(xyz[1]))
         self.rpy_deg.append(np.degrees(robot.torso_rpy_rad()))
+        self.tilt_deg.append(self._tilt_deg(robot))
         self.touch_share.append(touched / robot.substeps)
         self.effort.append(float(effort.max()))
         error = np.abs(robot.goals_rad() - robot.joint_angles_rad())
@@ -246,7 +248,7 @@ class WalkMeter:
         if self.fell_at_s is not None:
             return
         others = sorted({robot.model.geom(g).name or f"geom {g}" for g, _ in contacts if g not in robot.sole_side_of})
-        tilt = self._tilt_deg(robot)
+        tilt = self.tilt_deg[-1]
         reason = None
         if others:
             reason = f"{', '.join(others)} touched the floor"

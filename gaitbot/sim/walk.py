@@ -163,10 +163,11 @@ class SimWalk:
         return make_sim_bus(self.config, self.robot, now, recorder, self.imu_seed, self.imu_fault)
 
     def tilt_crossed_s(self, threshold_deg: float) -> float | None:
-        """When the torso's true tilt (hypot of roll and pitch, the IMU estimate's measure) first passed
-        ``threshold_deg`` (frame ends), or None: the yardstick of how soon a fall is noticed."""
-        for t_s, rpy in zip(self.meter.times_s, self.meter.rpy_deg):
-            if math.hypot(rpy[0], rpy[1]) > threshold_deg:
+        """When the torso's true tilt (the angle between its z axis and the world's up, the measure of the
+        IMU estimate's tilt_deg; not the hypot of roll and pitch, which overstates a tilt both ways at once)
+        first passed ``threshold_deg`` (frame ends), or None: the yardstick of how soon a fall is noticed."""
+        for t_s, tilt_deg in zip(self.meter.times_s, self.meter.tilt_deg):
+            if tilt_deg > threshold_deg:
                 return float(t_s)
         return None
 

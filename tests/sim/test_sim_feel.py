@@ -71,6 +71,19 @@ def test_a_fall_that_twists_as_it_tips_is_noticed_within_100_ms(capsys):
     assert 0 <= fall["t_s"] - fall["true_tilt_crossed_s"] <= 0.1
 
 
+def test_a_slow_fall_leaning_both_ways_is_noticed_within_100_ms(capsys):
+    # Push 67 of tools/push_survival.py with feedback none: the torso leans 24 deg to the side and 31 forward and
+    # hovers near the threshold for 100 ms before it goes over (docs/feedback.md, "A fall"): the slowest crossing
+    # of the 100 pushes, timed against the true tilt.
+    code, out, err = run_cli(capsys, "walk", "--sim", "--json", "--robot", "op3", "--distance", "1", "--cycle", "0.8",
+                             "--max-step", "0.06", "--feedback", "none", "--imu-seed", "67", "--push", "1.398@98.0",
+                             "--push-phase", "0.330787")
+    assert code == 1, err
+    fall = json.loads(out)["fall_noticed"]
+    assert fall["direction"] == "forwards"
+    assert 0 <= fall["t_s"] - fall["true_tilt_crossed_s"] <= 0.1
+
+
 def test_a_fall_is_noticed_within_100_ms_and_the_walk_stops_with_exit_1(tmp_path, capsys):
     record = tmp_path / "fall.jsonl"
     code, out, err = run_cli(capsys, "walk", "--sim", "--json", "--robot", "op3", "--distance", "0.6", "--push", "3",
@@ -102,3 +115,34 @@ def test_a_robot_without_an_imu_says_so_once_and_refuses_feedback(capsys):
     code, out, err = run_cli(capsys, "walk", "--dry-run", "--robot", "xl430-biped", "--distance", "0.2",
                              "--feedback", "gyro")
     assert code == 2 and "--feedback gyro: robot xl430-biped has no IMU" in err
+
+
+def test_the_yardstick_is_the_true_tilt_not_the_hypot_of_roll_and_pitch():
+    # A torso rolled 30 deg and pitched 30 deg leans acos(cos 30 cos 30) = 41.4 deg from upright (its z axis
+    # against the world's up, the measure of the IMU estimate's tilt), not hypot(30, 30) = 42.4: the yardstick
+    # a fall's notice is timed against must measure the same angle, or a fall leaning both ways looks noticed late.
+    import math
+
+    from gaitbot.robot.config import load_robot_config, resolve_config
+    from gaitbot.sim.metrics import WalkMeter
+    from gaitbot.sim.physics import SimRobot
+    from gaitbot.sim.walk import SimWalk
+
+    mujoco = import_mujoco()
+    robot = SimRobot(load_robot_config(resolve_config("op3")), 60.0, support="free")
+    roll = pitch = math.radians(30)
+    cr, sr, cp, sp = math.cos(roll / 2), math.sin(roll / 2), math.cos(pitch / 2), math.sin(pitch / 2)
+    robot.data.qpos[3:7] = (cp * cr, cp * sr, sp * cr, -sp * sr)  # R = Ry(pitch) Rx(roll): the quaternions' product
+    mujoco.mj_forward(robot.model, robot.data)
+    rpy = robot.torso_rpy_rad()
+    assert math.degrees(rpy[0]) == pytest.approx(30, abs=0.01) and math.degrees(rpy[1]) == pytest.approx(30, abs=0.01)
+    assert WalkMeter._tilt_deg(robot) == pytest.approx(math.degrees(math.acos(math.cos(roll) * math.cos(pitch))), abs=0.01)
+
+    class Meter:  # 42.4 deg by the hypot at 1 s, 41.4 by the tilt: only the tilt's crossing of 42 counts (at 2 s)
+        times_s = [1.0, 2.0]
+        rpy_deg = [(30.0, 30.0, 0.0), (31.0, 31.0, 0.0)]
+        tilt_deg = [41.4, 42.9]
+
+    walk = SimWalk.__new__(SimWalk)
+    walk.meter = Meter()
+    assert walk.tilt_crossed_s(42.0) == 2.0
