@@ -79,7 +79,8 @@ def _simulates(script: str) -> bool:
     text = (REPO_ROOT / script).read_text()
     if re.search(r"^\s*(from|import) (gaitbot\.sim|mujoco|op3_menagerie)\b|import_mujoco|\"--sim\"", text, re.M):
         return True
-    tools = {m for m in re.findall(r"^\s*import (\w+)", text, re.M) if (REPO_ROOT / "tools" / f"{m}.py").is_file()}
+    imported = re.findall(r"^\s*(?:import (\w+)|from (\w+) import)", text, re.M)
+    tools = {m for pair in imported for m in pair if m and (REPO_ROOT / "tools" / f"{m}.py").is_file()}
     return any(_simulates(f"tools/{m}.py") for m in tools if f"tools/{m}.py" != script)
 
 
