@@ -4,6 +4,7 @@ when and which way, the recording checks), a broken IMU noticed and the walk fin
 from __future__ import annotations
 
 import json
+import math
 import struct
 
 import pytest
@@ -15,6 +16,10 @@ try:
 except SimUnavailable:
     pytest.skip("the sim extra (MuJoCo) is not installed", allow_module_level=True)
 
+from gaitbot.robot.config import load_robot_config, resolve_config  # noqa: E402
+from gaitbot.sim.metrics import WalkMeter  # noqa: E402
+from gaitbot.sim.physics import SimRobot  # noqa: E402
+from gaitbot.sim.walk import SimWalk  # noqa: E402
 from helpers import crc16, parse_packet, read_lines, run_cli  # noqa: E402
 
 OPENCR_ID = 200
@@ -121,13 +126,6 @@ def test_the_yardstick_is_the_true_tilt_not_the_hypot_of_roll_and_pitch():
     # A torso rolled 30 deg and pitched 30 deg leans acos(cos 30 cos 30) = 41.4 deg from upright (its z axis
     # against the world's up, the measure of the IMU estimate's tilt), not hypot(30, 30) = 42.4: the yardstick
     # a fall's notice is timed against must measure the same angle, or a fall leaning both ways looks noticed late.
-    import math
-
-    from gaitbot.robot.config import load_robot_config, resolve_config
-    from gaitbot.sim.metrics import WalkMeter
-    from gaitbot.sim.physics import SimRobot
-    from gaitbot.sim.walk import SimWalk
-
     mujoco = import_mujoco()
     robot = SimRobot(load_robot_config(resolve_config("op3")), 60.0, support="free")
     roll = pitch = math.radians(30)
