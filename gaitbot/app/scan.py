@@ -2,7 +2,8 @@
 
 Per servo: id, baud rate, model by name, firmware, present position (ticks, and as its configured joint's
 angle), input voltage, temperature, torque, hardware errors in words; then the configured joints that did
-not answer (at their id, the config's baud rate and model). Reads only (gaitbot/bus/bringup.py). Exit 0
+not answer (at their id, the config's baud rate and model; each is pinged once more on its own before it is
+called missing). Reads only (gaitbot/bus/bringup.py). Exit 0
 when every configured joint answered as configured, 1 otherwise; ``--json`` prints one object.
 """
 
@@ -20,9 +21,9 @@ from gaitbot.app.progress import progress
 from gaitbot.servos import common_baud_rates, max_servo_id, vendor
 
 
-def survey_shown(probe, rates, what: str) -> list:
+def survey_shown(probe, rates, what: str, expected: dict | None = None) -> list:
     """``survey`` with a progress bar on a terminal (one step a PING; a broadcast ping is one step), the rate
-    being searched and the servos found so far beside it."""
+    being searched and the servos found so far beside it (``expected``: survey's)."""
     broadcast = probe.vendor.BROADCAST_PING.get(probe.protocol) is not None
     per_rate = 1 if broadcast else max_servo_id(probe.backend, probe.protocol) + 1
     found = []
@@ -32,7 +33,7 @@ def survey_shown(probe, rates, what: str) -> list:
         bar.set_postfix_str(f"{result.baudrate:,} baud done, {len(found)} found")
 
     with progress(what, total=len(rates) * per_rate, unit="ping") as bar:
-        return survey(probe, rates, on_baud=after_rate, on_ping=lambda _servo_id: bar.update())
+        return survey(probe, rates, on_baud=after_rate, on_ping=lambda _servo_id: bar.update(), expected=expected)
 
 
 def _joint_of(config, report: ServoReport):
@@ -102,7 +103,7 @@ def run(args) -> int:
         print(f"{config.name}: scanning {backend} protocol {protocol:g} on {port} at "
               f"{', '.join(f'{r:,}' for r in rates)} baud", flush=True)
     with probe:
-        results = survey_shown(probe, rates, "scan")
+        results = survey_shown(probe, rates, "scan", expected={config.bus.baudrate: [j.id for j in config.joints]})
         reports = [describe_servo(probe, s) for r in results for s in r.found]
     rows = [_row(config, r) for r in reports]
     missing = _missing(config, rows)

@@ -20,7 +20,7 @@ order, and nothing else (the e-Manual's "ID" and "Baud Rate" control-table entri
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 
 from gaitbot.bus.base import BusError, ServoTimeout
@@ -36,13 +36,15 @@ class SetupFailed(BusError):
 
 
 def survey(probe: ProbeBus, baudrates: Sequence[int], on_baud: Callable[[ProbeResult], None] | None = None,
-           on_ping: Callable[[int], None] | None = None) -> list[ProbeResult]:
+           on_ping: Callable[[int], None] | None = None,
+           expected: Mapping[int, Collection[int]] | None = None) -> list[ProbeResult]:
     """Search the bus at each rate in turn: every servo that answers, and the damaged replies, per rate
-    (``on_baud`` after each rate, ``on_ping`` after each PING: ProbeBus.search)."""
+    (``on_baud`` after each rate, ``on_ping`` after each PING, ``expected`` {rate: ids a config puts
+    there}: ProbeBus.search)."""
     results = []
     for rate in baudrates:
         probe.set_baudrate(rate)
-        result = probe.search(on_ping=on_ping)
+        result = probe.search(on_ping=on_ping, expected=(expected or {}).get(rate, ()))
         results.append(result)
         if on_baud is not None:
             on_baud(result)

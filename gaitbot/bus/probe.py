@@ -26,7 +26,7 @@ packet is counted in :attr:`ProbeResult.damaged`, so bring-up can refuse a bus w
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -142,9 +142,13 @@ class ProbeBus:
         self.baudrate = int(baudrate)
 
     # --- finding servos ---------------------------------------------------------------------
-    def search(self, ids: range | None = None, on_ping: Callable[[int], None] | None = None) -> ProbeResult:
+    def search(self, ids: range | None = None, on_ping: Callable[[int], None] | None = None,
+               expected: Collection[int] = ()) -> ProbeResult:
         """Every servo answering at the current baud rate (ids: every usable id). ``on_ping(servo_id)`` is
-        called after each PING of one id (progress; a broadcast ping calls it with the broadcast id)."""
+        called after each PING of one id (progress; a broadcast ping calls it with the broadcast id).
+        ``expected`` ids (a config's servos) that did not answer get a second look: a PING of their own, with
+        CONFIRM_TIMEOUT_MS and the retries, since a reply lost to a busy host or a slow adapter would
+        otherwise be a servo reported missing."""
         if self.baudrate is None:
             raise RuntimeError("set a baud rate first")
         ids = ids if ids is not None else range(0, max_servo_id(self.backend, self.protocol) + 1)
@@ -166,6 +170,13 @@ class ProbeBus:
                 numbers = answered
         else:
             numbers, result.damaged = self._ping_each(ids, on_ping)
+        for servo_id in sorted(set(expected) & set(ids) - set(numbers)):
+            for _ in range(1 + self.retries):
+                self._drop_stale()
+                outcome, number = self._ping_once(servo_id, CONFIRM_TIMEOUT_MS)
+                if outcome == "ok":
+                    numbers[servo_id] = number
+                    break
         for servo_id in sorted(i for i in numbers if i in ids):
             number = numbers[servo_id]
             if number is None:

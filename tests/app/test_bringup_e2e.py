@@ -245,6 +245,22 @@ def test_scan_lists_what_the_emulator_holds(protocol):
     assert [m["joint"] for m in result["missing_joints"]] == [missing.name]
 
 
+def test_scan_asks_a_configured_servo_again_before_calling_it_missing():
+    """A servo whose broadcast reply comes 40 ms late, after the 3 ms quiet window closed: it is found by a
+    ping of its own (the emulator's other servos answer in time, so the window does close before it)."""
+    robot = config(ROBOTS["dxl2"])
+    slow = robot.joints[3].id
+    emulator = se.ServoEmulator(se.EmulatorConfig(robot.bus.backend, robot.bus.protocol, dict(robot.models_by_id),
+                                                  robot.bus.baudrate, se.Faults(late_s={slow: 0.04})))
+    with emulator:
+        code, out, err = gaitbot_talking(["scan", "--robot", str(robot.path), "--port", emulator.path, "--json",
+                                          "--baud", str(robot.bus.baudrate), *FAST], lambda line: None)
+    assert code == 0, out + err
+    result = json.loads(out)
+    assert sorted(s["id"] for s in result["servos"]) == sorted(robot.models_by_id)
+    assert result["missing_joints"] == []
+
+
 # --------------------------------------------------------------------------- health while walking
 
 
