@@ -3,8 +3,8 @@
 Per servo: id, baud rate, model by name, firmware, present position (ticks, and as its configured joint's
 angle), input voltage, temperature, torque, hardware errors in words; then the configured joints that did
 not answer (at their id, the config's baud rate and model; each is pinged once more on its own before it is
-called missing). Reads only (gaitbot/bus/bringup.py). Exit 0
-when every configured joint answered as configured, 1 otherwise; ``--json`` prints one object.
+called missing). Reads only (gaitbot/bus/bringup.py). Exit 0 when every configured joint answered as
+configured, 1 otherwise; ``--json`` prints one object.
 """
 
 from __future__ import annotations
