@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Collection, Mapping
 
 from gaitbot.app.arguments import add_command, bus_options, robot_options
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port
@@ -21,7 +22,7 @@ from gaitbot.app.progress import progress
 from gaitbot.servos import common_baud_rates, max_servo_id, vendor
 
 
-def survey_shown(probe, rates, what: str, expected: dict | None = None) -> list:
+def survey_shown(probe, rates, what: str, expected: Mapping[int, Collection[int]] | None = None) -> list:
     """``survey`` with a progress bar on a terminal (one step a PING; a broadcast ping is one step), the rate
     being searched and the servos found so far beside it (``expected``: survey's)."""
     broadcast = probe.vendor.BROADCAST_PING.get(probe.protocol) is not None
