@@ -9,8 +9,8 @@ limit window. Three lines: the feedback alone (--frames frames of a sway), and t
 really does, the online balanced walker's ``next_frame`` (30 steps queued, as tools/bench_balance.py) with the
 feedback on its goals; and ``--feedback zmp``'s CoM correction alone (its support polygon and one step). Both in wall time and in CPU time of this thread (time.thread_time): on a shared machine
 the wall p99 is the host's scheduling, the CPU p99 is the code's. Last, ``--feedback step``'s frames by what
-they do (queue a step, queue a queued step again after a push, take it back for a pause, none of these), in
-CPU time.
+they do (queue a step, a stage of a moved step's check, queue the moved step, take a step back for a pause,
+none of these), in CPU time.
 """
 
 from __future__ import annotations
@@ -130,31 +130,38 @@ class LeaningFrom:
 
 def stepping_frames(config, repeats: int = 5) -> list[str]:
     """``--feedback step``'s frames (gaitbot.drive.stepping) of six 6 cm steps with a lean felt from frame
-    110: the frames that queue a step (its capture decision and whole step check), the frames that take a
-    queued step back and queue it again, those that take it back for a pause, and the others; CPU time of the
-    thread."""
+    110, by what they do: queue a step (with its capture decision), one stage of a moved step's check, queue
+    the moved step in place of the queued one, take the queued step back for a pause, none of these; CPU
+    time of the thread."""
     from gaitbot.drive.stepping import SteppingFrames
     from gaitbot.robot.balanced_walk import balanced_gait_settings, plan_balanced
 
     plan = plan_balanced(config, [0.06] * 6, balanced_gait_settings(config, cycle_s=0.8, max_step_m=0.06))
-    cpu: dict[str, list[float]] = {"queue a step": [], "queue a step again": [], "pause": [], "other": []}
+    kinds = ("queue a step", "a stage of a check", "queue a moved step", "pause", "other")
+    cpu: dict[str, list[float]] = {kind: [] for kind in kinds}
     for _ in range(repeats):
         felt = LeaningFrom(110)
         frames = SteppingFrames(config, plan, felt)
         frames_iter = iter(frames)
         while True:
             steps, moved, paused = frames.log.steps, len(frames.log.moved), len(frames.log.paused_s)
+            checking = frames._checking is not None
             c = time.thread_time()
             try:
                 next(frames_iter)
             except StopIteration:
                 break
             took = time.thread_time() - c
-            again = len(frames.log.moved) > moved and frames.log.moved[-1][2]
             if len(frames.log.paused_s) > paused:
                 kind = "pause"
+            elif frames.log.steps > steps:
+                kind = "queue a step"
+            elif len(frames.log.moved) > moved:
+                kind = "queue a moved step"
+            elif checking or frames._checking is not None:
+                kind = "a stage of a check"
             else:
-                kind = "queue a step" if frames.log.steps > steps else "queue a step again" if again else "other"
+                kind = "other"
             cpu[kind].append(took)
             felt.tick()
     return [f"--feedback step, {kind}: CPU p50 {np.median(v) * 1e3:.2f} ms, max {max(v) * 1e3:.2f} ms over "

@@ -67,24 +67,26 @@ class StepCheck:
         self.min_gap_m = config.steer.min_gap_m if config.steer is not None else 0.0
         self.margin_m = ZMP_MARGIN_SHARE * self.geometry.foot_width_m
 
-    def check(self, walker, step) -> str | None:
+    def check(self, walker, step, replacing_last: bool = False) -> str | None:
         """Why ``step`` (a gaitbot.gait.steer.planner.Footstep for the walker's next swing foot) would fail,
         or None; the walker does not change. All stages at once (see ``stages``)."""
-        stages = self.stages(walker, step)
+        stages = self.stages(walker, step, replacing_last)
         while True:
             try:
                 next(stages)
             except StopIteration as done:
                 return done.value
 
-    def stages(self, walker, step):
+    def stages(self, walker, step, replacing_last: bool = False):
         """``check`` as a generator of STAGES stages (one a frame in a live drive: each well under a
-        millisecond); its return value is the reason or None. Valid while the walker gets no other step."""
+        millisecond); its return value is the reason or None. Valid while the walker gets no other step.
+        ``replacing_last``: ``step`` in place of the walker's last step, not started (BalancedWalker.preview_step)."""
         gap = step.gap_m  # measured by the planner over the swing's path, its last resort included
         if gap < self.min_gap_m - GAP_TOLERANCE_M:
             return f"would bring the soles {gap * 1e3:.1f} mm apart (the least is {self.min_gap_m * 1e3:.0f} mm)"
         arrays, first, end = walker.preview_step(step.foothold, max(0.0, step.length_m),
-                                                 before_frames=round(KERNEL_SPAN / self.omega(walker) / self.period_s))
+                                                 before_frames=round(KERNEL_SPAN / self.omega(walker) / self.period_s),
+                                                 replacing_last=replacing_last)
         yield
         reason = self._balance(arrays, first, end)
         if reason is not None:

@@ -5,8 +5,11 @@ BalancedWalker (the drive's walker, with the plan's own speed-fitted settings, s
 plan's frames), each appended DECIDE_FRAMES frames before its double support starts: about when the step before it starts,
 as the live drive queues its steps, early enough for the walker's preview to see the step coming. At that moment gaitbot.feel.capture compares the measured
 DCM with the plan's; if it left what the ankles hold, the step's foothold moves toward it (within ``[steer]``
-limits and the soles' gap). Until that step starts, a push felt later moves it again (``_redecide``: the walker
-takes it back and it is queued to the new foothold). When the error leans toward the foot that step would
+limits and the soles' gap). The moved step is checked (gaitbot.drive.step_check) in place of the planned one,
+which is queued at once: a stage a frame, as the live drive checks its steps, so that no frame carries more
+than one piece of planning; once it passes, the walker takes the planned step back and it is queued to the
+moved foothold (``_advance_check``). Until that step starts, a push felt later moves it again
+(``_redecide``: checked the same way). When the error leans toward the foot that step would
 lift, so that standing on the other foot would leave the DCM further outside it, the step waits instead
 (``_pause``): it is taken back, both feet stay down for PAUSE_FRAMES with the ZMP between them, and it is
 queued again before the pause ends, its weight shifted over a whole step as a walk's first step's is. The
@@ -83,9 +86,10 @@ class QueuedStep:
 
 @dataclass
 class SteppingLog:
-    """The decisions taken: one CaptureStep per move of a step (with when it was decided: s from the walk's
-    start, and whether the step had been queued and was moved again), and how many times the error left the
-    hold but nothing moved (inward only, or refused by the step check: the plan's foothold kept)."""
+    """The decisions taken: one CaptureStep per move of a step (with when the moved step was queued, its check
+    passed: s from the walk's start; and whether the step had been queued and was moved again), and how many
+    times the error left the hold but nothing moved (inward only, or refused by the step check: the plan's
+    foothold kept)."""
 
     moved: list[tuple[float, CaptureStep, bool]] = field(default_factory=list)
     steps: int = 0
@@ -93,7 +97,8 @@ class SteppingLog:
     paused_s: list[float] = field(default_factory=list)
 
     def summary(self) -> list[dict]:
-        """The moved steps for ``--json``: when decided (s of the walk), the DCM's error and the move (m)."""
+        """The moved steps for ``--json``: when queued (``decided_s``, s of the walk), the DCM's error and the
+        move (m)."""
         return [{"decided_s": round(t_s, 4), "side": c.foothold.side, "requeued": requeued,
                  "dcm_error_m": [round(v, 4) for v in c.error_m], "moved_m": [round(v, 4) for v in c.moved_m]}
                 for t_s, c, requeued in self.moved]
@@ -143,6 +148,8 @@ class SteppingFrames:
         self.rate_hz = self.walker.rate_hz
         self.log = SteppingLog()
         self._queued: QueuedStep | None = None  # the step appended last (moved again by _redecide)
+        self._checking = None  # the check of a move of the queued step, a stage a frame (_moving)
+        self._moved: tuple[CaptureStep, bool] | None = None  # a move that passed it (and requeued), queued next
         self._pauses = 0  # pauses in a row before the queued step
         self._resume_frame = 0  # the walk frame where the last pause ends
         self._next = 0
@@ -156,7 +163,8 @@ class SteppingFrames:
         return self
 
     def __next__(self) -> np.ndarray:
-        if not self._append_due() and not self._pause() and not self._redecide():
+        # at most one piece of planning a frame (an append, a pause, a stage of a check), as the drive does
+        if not self._append_due() and not self._pause() and not self._advance_check() and not self._redecide():
             self.walker.work()  # a share of the last append's replan, as the drive does (BalancedWalker.work)
         if self.correction is not None:
             self._correct()
@@ -186,22 +194,47 @@ class SteppingFrames:
         planned = FootPlacement(step.leg, stance.x_m + step.length_m,
                                 stance.y_m + SIDE_SIGN[step.leg] * self.config.body.geometry.hip_width_m, 0.0)
         queued = QueuedStep(stance, swing_from, planned, step.length_m, planned)
+        walker.append_footstep(planned, step.length_m, spread=True)
+        self._queued = queued if self.stepping else None
+        self._checking = self._moved = None  # (a check of the step before: it has started)
         decision = self._decide(stance, swing_from, planned)
         if decision is not None and decision.beyond:
-            queued.foothold = self._checked_foothold(decision, queued)
-        walker.append_footstep(queued.foothold, step.length_m, spread=True)
-        self._queued = queued if self.stepping else None
+            self._checking = self._moving(decision, queued)
         return True
 
-    def _checked_foothold(self, decision: CaptureStep, queued: QueuedStep, requeued: bool = False) -> FootPlacement:
-        """The foothold of a decision beyond the hold, as the step check lets it through (logged; ``requeued``:
-        a step taken back and moved again); the walker stands as before the step."""
-        decision = self._checked(decision, queued.stance, queued.swing_from, queued.planned, queued.length_m)
+    def _advance_check(self) -> bool:
+        """A frame's piece of a move's check (``_moving``): the next stage, or the queued step taken back and
+        queued again to the moved foothold that passed. Dropped if that step has started meanwhile. Whether
+        it did a piece."""
+        queued, walker = self._queued, self.walker
+        if self._checking is None and self._moved is None:
+            return False
+        if queued is None or not walker.last_step_unstarted:
+            self._checking = self._moved = None
+            return False
+        if self._moved is not None:
+            (decision, requeued), self._moved = self._moved, None
+            walker.retract_last_step()
+            walker.append_footstep(decision.foothold, queued.length_m, spread=True)
+            queued.foothold = decision.foothold
+            self.log.moved.append((walker._out / self.rate_hz, decision, requeued))
+            return True
+        try:
+            next(self._checking)
+        except StopIteration as done:
+            self._checking, self._moved = None, done.value
+        return True
+
+    def _moving(self, decision: CaptureStep, queued: QueuedStep, requeued: bool = False):
+        """A generator, one check stage a frame: a decision beyond the hold as the step check lets it through
+        in place of the queued step, and ``requeued`` (moved again; both logged once it is queued), or None
+        (refused: the queued foothold stays)."""
+        decision = yield from self._checked(decision, queued.stance, queued.swing_from, queued.planned,
+                                            queued.length_m)
         if decision.moved_m == (0.0, 0.0):
             self.log.refused += 1
-            return queued.planned
-        self.log.moved.append((self.walker._out / self.rate_hz, decision, requeued))
-        return decision.foothold
+            return None
+        return decision, requeued
 
     def _pause(self) -> bool:
         """The step queued last, not started yet, taken back and a pause of PAUSE_FRAMES queued instead when the
@@ -219,7 +252,7 @@ class SteppingFrames:
             return False
         walker.retract_last_step()
         walker.append_pause(PAUSE_FRAMES, spread=True)
-        self._queued = None
+        self._queued, self._checking, self._moved = None, None, None
         self._next -= 1
         self.log.steps -= 1
         self._pauses += 1
@@ -230,8 +263,9 @@ class SteppingFrames:
 
     def _redecide(self) -> bool:
         """The step queued last, not started yet, moved again when the DCM's error now asks for a foothold
-        REDECIDE_M or more from the one it was given (a push felt after the step was queued): taken back
-        and appended to the new foothold, once a step. Whether it did."""
+        REDECIDE_M or more from the one it was given (a push felt after the step was queued): its check
+        started (``_moving``; taken back and queued to the new foothold once it passes), once a step. Whether
+        it did."""
         queued, walker = self._queued, self.walker
         if queued is None or queued.redecided or not walker.last_step_unstarted:
             return False
@@ -242,10 +276,8 @@ class SteppingFrames:
         if math.hypot(moved.x_m - queued.foothold.x_m, moved.y_m - queued.foothold.y_m) < REDECIDE_M:
             return False
         queued.redecided = True
-        walker.retract_last_step()
-        queued.foothold = self._checked_foothold(decision, queued, requeued=True)
-        walker.append_footstep(queued.foothold, queued.length_m, spread=True)
-        return True
+        self._checking = self._moving(decision, queued, requeued=True)
+        return self._advance_check()
 
     def _correct(self) -> None:
         """The next frame's CoM correction from the measured error (none before the balance plan starts)."""
@@ -270,14 +302,15 @@ class SteppingFrames:
         log.max_zmp_shift_m = max(log.max_zmp_shift_m, math.hypot(*corr.zmp_shift_m))
         log.clipped = corr.clipped
 
-    def _checked(self, decision: CaptureStep, stance, swing_from, planned, length_m: float) -> CaptureStep:
-        """The move, or its half, that passes the drive's step check (reach, limits, ZMP, gap); else none."""
+    def _checked(self, decision: CaptureStep, stance, swing_from, planned, length_m: float):
+        """A generator of the check's stages: the move, or its half, that passes the drive's step check (reach,
+        limits, ZMP, gap) in place of the queued step; else none."""
         for _ in range(CHECK_TRIES):
             if decision.moved_m == (0.0, 0.0):
                 return decision
             step = MovedStep(decision.foothold, length_m, decision.gap_m)
             try:
-                reason = self.step_check.check(self.walker, step)
+                reason = yield from self.step_check.stages(self.walker, step, replacing_last=True)
             except (ValueError, ArithmeticError) as exc:  # beyond the swing's shapes or the leg's reach
                 reason = str(exc)
             if reason is None:

@@ -108,11 +108,26 @@ def test_nothing_felt_walks_the_plan_and_a_felt_push_left_moves_a_foothold_left(
     # ahead, not the whole walk)
     assert np.abs(frames - planned).max() <= 0.01 * 4096
     leaning_left = SteppingFrames(cfg, plan, Felt(roll_deg=-4.0, rates=(-30.0, 0.0, 0.0)))
-    list(leaning_left)
+    walked = walked_moves(leaning_left)
     assert leaning_left.log.moved
     for _, step, _ in leaning_left.log.moved:
         assert step.moved_m[1] >= 0.0 and step.error_m[1] > 0
-    assert any(step.moved_m[1] > 0.01 for _, step, _ in leaning_left.log.moved)
+    # the moves are walked: steps start at footholds left of the plan's (after the pauses a lean toward the
+    # lifting foot asks first, and at the part of the move the knee's speed allows from standing)
+    assert any(dy > 0.005 for _, dy in walked) and all(dy >= 0.0 for _, dy in walked)
+
+
+def walked_moves(frames, each=lambda: None) -> list[tuple[float, float]]:
+    """Walk ``frames`` (a SteppingFrames) to its end, calling ``each()`` after every frame; for each step as it
+    starts: its foothold's move from the plan's (dx, dy; m), read from the walker's queue, not from the log."""
+    walked, seen = [], None
+    for _ in frames:
+        each()
+        queued = frames._queued
+        if queued is not None and queued is not seen and not frames.walker.last_step_unstarted:
+            seen = queued
+            walked.append((queued.foothold.x_m - queued.planned.x_m, queued.foothold.y_m - queued.planned.y_m))
+    return walked
 
 
 class FeltFrom(Felt):
@@ -130,9 +145,10 @@ class FeltFrom(Felt):
 
 
 def test_a_push_felt_after_a_step_was_queued_moves_that_step_before_it_starts(op3_plan):
-    """The step queued next, not started when the push is felt, is taken back and moved at once (requeued)
-    rather than the push waiting for the next step to be queued."""
-    from gaitbot.drive.stepping import SteppingFrames
+    """The step queued next, not started when the push is felt, is taken back and moved (requeued) once its
+    check has passed, a stage a frame, rather than the push waiting for the next step to be queued."""
+    from gaitbot.drive.step_check import STAGES
+    from gaitbot.drive.stepping import CHECK_TRIES, SteppingFrames
 
     cfg, plan = op3_plan
     quiet = SteppingFrames(cfg, plan, Felt(started=False))
@@ -143,13 +159,13 @@ def test_a_push_felt_after_a_step_was_queued_moves_that_step_before_it_starts(op
     felt_frame = queued_at[len(queued_at) // 2]
     felt = FeltFrom(felt_frame)
     pushed = SteppingFrames(cfg, plan, felt)
-    for _ in pushed:
-        felt.tick()
+    walked = walked_moves(pushed, felt.tick)
     after = [(t, step, again) for t, step, again in pushed.log.moved if t >= (felt_frame - 1) / pushed.rate_hz]
     t_s, step, again = after[0]
     assert again, "the first move after the push was felt waited for a new step"
-    assert t_s <= (felt_frame + 1) / pushed.rate_hz  # at once
+    assert t_s <= (felt_frame + 2 + STAGES * CHECK_TRIES) / pushed.rate_hz  # the check's frames, then queued
     assert step.moved_m[0] < -0.005 and step.error_m[0] < 0  # backward, where the push went
+    assert any(dx < -0.005 for dx, _ in walked)  # and walked there
 
 
 def test_a_lean_toward_the_foot_about_to_lift_pauses_on_both_feet_and_one_away_does_not(op3_plan):

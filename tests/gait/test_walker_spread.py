@@ -147,6 +147,39 @@ def test_a_step_taken_back_and_appended_elsewhere_plans_as_if_appended_there_at_
     assert np.abs(ends[0] - ends[1]).max() < 1e-6
 
 
+def test_a_step_previewed_in_place_of_the_queued_one_is_the_step_previewed_after_taking_that_one_back():
+    """BalancedWalker.preview_step(replacing_last=True) (a moved step checked while the planned one stays
+    queued, gaitbot.drive.stepping): the same arrays as a preview after retract_last_step, the walker
+    unchanged; refused once the queued step has started."""
+    import copy
+
+    from gaitbot.gait.balance.zmp_reference import FootPlacement
+
+    walker, _ = walking_forward(3)
+    for _ in range(walker.rise_frames + 30):
+        walker.next_frame()
+    side = walker.next_swing_side
+    stance = walker.feet["left" if side == "right" else "right"]
+    y = stance.y_m + (OP3.body.geometry.hip_width_m if side == "left" else -OP3.body.geometry.hip_width_m)
+    walker.append_footstep(FootPlacement(side, stance.x_m + 0.04, y, 0.0), 0.04)
+    walker.next_frame()
+    moved = FootPlacement(side, stance.x_m + 0.05, y + (0.02 if side == "left" else -0.02), 0.0)
+    before = copy.deepcopy(walker.plan_arrays())
+    arrays, first, end = walker.preview_step(moved, 0.05, before_frames=40, replacing_last=True)
+    for key, a in before.items():  # the walker did not change
+        np.testing.assert_array_equal(walker.plan_arrays()[key], a, err_msg=key)
+    taken_back = copy.deepcopy(walker)
+    taken_back.retract_last_step()
+    expected, first_expected, end_expected = taken_back.preview_step(moved, 0.05, before_frames=40)
+    assert (first, end) == (first_expected, end_expected)
+    for key, a in expected.items():
+        np.testing.assert_array_equal(arrays[key], a, err_msg=key)
+    while walker.last_step_unstarted:
+        walker.next_frame()
+    with pytest.raises(RuntimeError):
+        walker.preview_step(moved, 0.05, replacing_last=True)
+
+
 def test_a_pause_stands_on_both_feet_with_the_zmp_between_them_and_the_next_step_shifts_its_weight_slowly():
     """BalancedWalker.append_pause (a push that lifting the next foot would make worse, gaitbot.drive.stepping):
     for its frames both feet stay where they stand and neither swings, the ZMP reference ends between the

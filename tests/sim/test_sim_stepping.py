@@ -1,6 +1,6 @@
-"""Capture-point stepping in the simulated walk (``--feedback step``): a sideways push moves a foothold to the
-side it came from, and the recording of the pushed walk passes ``gaitbot check`` (no feedback, no moved step,
-breaks a limit)."""
+"""Capture-point stepping in the simulated walk (``--feedback step``): a sideways push is answered (a moved
+foothold, never against it, or a pause on both feet), and the recording of the pushed walk passes ``gaitbot
+check`` (no feedback, no moved step, breaks a limit)."""
 
 from __future__ import annotations
 
@@ -22,19 +22,18 @@ WALK = ("walk", "--sim", "--json", "--robot", "op3", "--distance", "1", "--cycle
 
 
 @pytest.mark.parametrize("direction, axis, sign", [(90, 1, 1.0), (270, 1, -1.0)])
-def test_a_sideways_push_moves_a_foothold_its_way_and_the_recording_checks(tmp_path, capsys, direction, axis, sign):
+def test_a_sideways_push_is_answered_its_way_and_the_recording_checks(tmp_path, capsys, direction, axis, sign):
     record = tmp_path / "pushed.jsonl"
     code, out, err = run_cli(capsys, *WALK, "--feedback", "step", "--push", f"1.5@{direction}", "--record", record)
     assert code in (0, 1), err
     report = json.loads(out)
-    moves = report["capture_steps"]
-    assert moves, "the push was felt but no foothold moved"
+    moves, pauses = report["capture_steps"], report["capture_pauses_s"]
+    assert moves or pauses, "the push was felt but nothing answered it"
     # the DCM error the IMU measured points the way the push went (left for 90 deg, right for 270): an
-    # independent reading of the push's direction; no foothold ever moves against it
-    assert sign * moves[0]["dcm_error_m"][axis] > 0
-    assert all(sign * m["moved_m"][axis] >= 0 for m in moves if sign * m["dcm_error_m"][axis] > 0)
-    if sign > 0:  # pushed left while the left foot was about to swing: it steps out to the left
-        assert any(m["moved_m"][axis] > 0.005 for m in moves)
+    # independent reading of the push's direction; no foothold ever moves against it (a push toward the foot
+    # about to lift is waited out on both feet first: the next test)
+    assert all(sign * m["dcm_error_m"][axis] > 0 for m in moves)
+    assert all(sign * m["moved_m"][axis] >= 0 for m in moves)
     assert run_cli(capsys, "check", record)[0] == 0
 
 

@@ -262,18 +262,26 @@ class BalancedWalker(Lookahead):
         return self._committed
 
     def preview_step(self, foothold: FootPlacement, length_m: float = 0.0,
-                     before_frames: int = 0) -> tuple[dict, int, int]:
+                     before_frames: int = 0, replacing_last: bool = False) -> tuple[dict, int, int]:
         """The plan arrays (PLAN_KEYS) of the last ``before_frames`` frames planned, one more step to
         ``foothold`` and the provisional close-and-stand after it (what the walker previews when no other
         step follows), computed on copies: the walker does not change (a live drive checks a step this way
-        before it appends it). Returns (arrays, first, end): the step's own frames are
-        ``arrays[key][first:end]``."""
-        blocks, state = PlanBlocks(), self._state.copy()
+        before it appends it). ``replacing_last``: the step in place of the last one appended, which has not
+        started (``last_step_unstarted``: the plan as ``retract_last_step`` would leave it; a moved step is
+        checked this way while the planned one stays queued). Returns (arrays, first, end): the step's own
+        frames are ``arrays[key][first:end]``."""
+        state, planned = self._state, self._arrays
+        if replacing_last:
+            if not self.last_step_unstarted:
+                raise RuntimeError("the last step has started (or there is none to take back)")
+            state, committed = self._last_step[:2]
+            planned = {key: a[:committed - self._base] for key, a in planned.items()}
+        blocks, state = PlanBlocks(), state.copy()
         self.planner.step_to(blocks, state, foothold, float(length_m))
         n = blocks.frames
         new = blocks.arrays()
-        before = min(int(before_frames), len(self._arrays["zmp"]))
-        arrays = {k: np.concatenate([self._arrays[k][len(self._arrays[k]) - before:], new[k]]) for k in new}
+        before = min(int(before_frames), len(planned["zmp"]))
+        arrays = {k: np.concatenate([planned[k][len(planned[k]) - before:], new[k]]) for k in new}
         return arrays, before, before + n
 
     def lead_with(self, side: str) -> None:
