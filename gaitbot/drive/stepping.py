@@ -196,7 +196,7 @@ class SteppingFrames:
         queued = QueuedStep(stance, swing_from, planned, step.length_m, planned)
         walker.append_footstep(planned, step.length_m, spread=True)
         self._queued = queued if self.stepping else None
-        self._checking = self._moved = None  # (a check of the step before: it has started)
+        self._checking = self._moved = None  # (the step before is no longer the last: not taken back)
         decision = self._decide(stance, swing_from, planned)
         if decision is not None and decision.beyond:
             self._checking = self._moving(decision, queued)
