@@ -52,7 +52,7 @@ KERNEL_SPAN = 4.0
 
 
 class StepCheck:
-    """``check(walker, step)``: why the step would fail, or None."""
+    """``stages(walker, step)``: why the step would fail, or None, a stage a frame."""
 
     def __init__(self, config, period_s: float) -> None:
         joints = {j.name: j for j in config.joints}
@@ -67,19 +67,10 @@ class StepCheck:
         self.min_gap_m = config.steer.min_gap_m if config.steer is not None else 0.0
         self.margin_m = ZMP_MARGIN_SHARE * self.geometry.foot_width_m
 
-    def check(self, walker, step, replacing_last: bool = False) -> str | None:
-        """Why ``step`` (a gaitbot.gait.steer.planner.Footstep for the walker's next swing foot) would fail,
-        or None; the walker does not change. All stages at once (see ``stages``)."""
-        stages = self.stages(walker, step, replacing_last)
-        while True:
-            try:
-                next(stages)
-            except StopIteration as done:
-                return done.value
-
     def stages(self, walker, step, replacing_last: bool = False):
-        """``check`` as a generator of STAGES stages (one a frame in a live drive: each well under a
-        millisecond); its return value is the reason or None. Valid while the walker gets no other step.
+        """Why ``step`` (a gaitbot.gait.steer.planner.Footstep for the walker's next swing foot) would fail,
+        as a generator of STAGES stages (one a frame: each well under a millisecond) whose return value is the
+        reason or None; the walker does not change. Valid while the walker gets no other step.
         ``replacing_last``: ``step`` in place of the walker's last step, not started (BalancedWalker.preview_step)."""
         gap = step.gap_m  # measured by the planner over the swing's path, its last resort included
         if gap < self.min_gap_m - GAP_TOLERANCE_M:
