@@ -14,9 +14,9 @@ import pytest
 
 from helpers import REPO_ROOT, knee_calibration, run_cli
 
-STAIRS = REPO_ROOT / "config" / "terrain" / "stairs.toml"
+DITCH = REPO_ROOT / "config" / "terrain" / "ditch.toml"  # one tread: a course walk planned in seconds
 KERB = REPO_ROOT / "config" / "terrain" / "kerb.toml"
-#: One worker runs this module, so that the files below (a stairs walk among them) are made once.
+#: One worker runs this module, so that the files below (a course walk among them) are made once.
 pytestmark = pytest.mark.xdist_group("file-origin")
 
 
@@ -28,7 +28,7 @@ def files(tmp_path_factory):
     out = {"dir": folder}
     for name, argv in (("op3.csv", ["--robot", "op3", "--distance", "0.2"]),
                        ("op3.npz", ["--robot", "op3", "--distance", "0.2"]),
-                       ("stairs.csv", ["--terrain", str(STAIRS)])):
+                       ("ditch.csv", ["--terrain", str(DITCH)])):
         assert main(["generate", *argv, "-o", str(folder / name)]) == 0
         out[name] = folder / name
     return out
@@ -59,8 +59,8 @@ def test_the_file_names_its_robot_and_course(files):
         assert origin == read_origin(files[name])
         assert origin.robot == "op3" and origin.treads == ()
         assert origin.robot_geometry == geometry_fingerprint(load_robot_config(resolve_config("op3")))
-    stairs = Trajectory.load(files["stairs.csv"]).origin
-    assert stairs.robot == "xl430-biped" and stairs.treads == load_course(STAIRS).terrain.treads
+    ditch = Trajectory.load(files["ditch.csv"]).origin
+    assert ditch.robot == "xl430-biped" and ditch.treads == load_course(DITCH).terrain.treads
 
 
 def test_fingerprint_follows_the_geometry_only():
@@ -81,16 +81,16 @@ def test_plot_draws_the_files_robot(capsys, files, tmp_path):
     assert code == 0 and "drawn for xl430-biped" in out
 
 
-def test_plot_draws_the_files_stairs(capsys, files, tmp_path, monkeypatch):
+def test_plot_draws_the_files_course(capsys, files, tmp_path, monkeypatch):
     import gaitbot.plot
     from gaitbot.gait.terrain.course_file import load_course
 
     seen = {}
     monkeypatch.setattr(gaitbot.plot, "plot_trajectory",
                         lambda trajectory, geometry, path, **kw: seen.update(kw) or Path(path).write_bytes(b"png"))
-    code, out, err = run_cli(capsys, "plot", files["stairs.csv"], "-o", tmp_path / "s.png")
+    code, out, err = run_cli(capsys, "plot", files["ditch.csv"], "-o", tmp_path / "s.png")
     assert code == 0, err
-    assert seen["terrain"].treads == load_course(STAIRS).terrain.treads and "6 treads" in out
+    assert seen["terrain"].treads == load_course(DITCH).terrain.treads and "1 treads" in out  # the ditch's one
 
 
 def test_contradicting_robot_or_terrain_is_refused(capsys, files, tmp_path):
@@ -100,12 +100,12 @@ def test_contradicting_robot_or_terrain_is_refused(capsys, files, tmp_path):
     assert "made for robot 'op3'" in err
     err = one_line_exit_2(run_cli(capsys, "walk", "--dry-run", "--trajectory", files["op3.csv"], "--robot", "ax12a-biped"))
     assert "made for robot 'op3'" in err
-    err = one_line_exit_2(run_cli(capsys, "plot", files["stairs.csv"], "--terrain", KERB, "-o", tmp_path / "y.png"))
-    assert "walked on the course" in err and "stairs.toml" in err
+    err = one_line_exit_2(run_cli(capsys, "plot", files["ditch.csv"], "--terrain", KERB, "-o", tmp_path / "y.png"))
+    assert "walked on the course" in err and "ditch.toml" in err
     err = one_line_exit_2(run_cli(capsys, "plot", files["op3.csv"], "--terrain", KERB, "-o", tmp_path / "z.png"))
     assert "walked on flat ground" in err
     # saying what the file says is no contradiction
-    code, _, err = run_cli(capsys, "plot", files["stairs.csv"], "--terrain", STAIRS, "--robot", "xl430-biped",
+    code, _, err = run_cli(capsys, "plot", files["ditch.csv"], "--terrain", DITCH, "--robot", "xl430-biped",
                            "-o", tmp_path / "w.png")
     assert code == 0, err
 
