@@ -67,7 +67,7 @@ def test_dropping_the_plan_behind_the_output_changes_no_frame(monkeypatch):
 @pytest.mark.slow
 def test_five_minutes_of_walking_hold_bounded_memory():
     """A long walk without a stop, on the walker's own clock (no sleeping): its stores stay bounded. Five
-    minutes drop the plan behind the output fifteen times (every STORED_FRAMES = 20 s at 60 Hz)."""
+    minutes drop the plan behind the output fifteen times (once STORED_FRAMES have gathered: about every 20 s)."""
     walker = balanced_walker(OP3, GAIT)
     planner = footstep_planner(OP3, GAIT)
     walker.lead_with("left")
