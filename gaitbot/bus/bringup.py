@@ -13,7 +13,9 @@ order, and nothing else (the e-Manual's "ID" and "Baud Rate" control-table entri
 3. ID = the new id, at the old id, not waited for (whether the servo answers as its old or its new self
    is not documented); then a PING at the new id confirms it;
 4. Baud Rate = the new rate's register value, at the new id, not waited for (the answer may come at either
-   rate); once the write has left the port (and 10 ms more) the host switches to the new rate;
+   rate); once the write has left the port (and 10 ms more) the host switches to the new rate and PINGs;
+   if only the old rate answers, the servo never heard the write (it is sent unconfirmed, so noise or a
+   busy host that switched too soon loses it) and it is written again, up to BAUD_WRITE_TRIES times;
 5. read back ID, Baud Rate and Model Number at the new id and rate; Feetech: Lock = 1 again (its
    power-on state; the id and rate written while it was 0 are saved).
 """
@@ -29,6 +31,10 @@ from gaitbot.servos import baud_rates, baud_register_value
 from gaitbot.servos.health import HealthReading, decode_health, health_block
 from gaitbot.servos.models import ServoModel
 from gaitbot.servos.status import describe_status_error, hardware_error_bits
+
+
+#: Baud Rate writes sent before setup gives up on a servo that still answers at its old rate.
+BAUD_WRITE_TRIES = 3
 
 
 class SetupFailed(BusError):
@@ -95,9 +101,20 @@ def assign_id_and_baud(probe: ProbeBus, found: ServoFound, model: ServoModel, ne
                               f"at id {new_id}; run setup again for this joint", servo_id=servo_id)
         servo_id = new_id
     if new_baudrate != found.baudrate:
-        write("Baud Rate", baud.address, value, confirm=False)
-        probe.drain()  # the write must leave at the old rate before the host switches
-        probe.set_baudrate(new_baudrate)
+        for _ in range(BAUD_WRITE_TRIES):
+            write("Baud Rate", baud.address, value, confirm=False)
+            probe.drain()  # the write must leave at the old rate before the host switches
+            probe.set_baudrate(new_baudrate)
+            if probe.ping(servo_id):
+                break
+            probe.set_baudrate(found.baudrate)  # not heard at the new rate: did the write reach it at all?
+            if not probe.ping(servo_id):
+                probe.set_baudrate(new_baudrate)
+                break  # silent at both rates: the read-back below says so
+        else:
+            raise SetupFailed(f"servo {servo_id} still answers at {found.baudrate:,} baud after {BAUD_WRITE_TRIES} "
+                              f"writes of its Baud Rate ({value}, {new_baudrate:,} baud); check its cable and run "
+                              "setup again for this joint", servo_id=servo_id)
     try:
         got_id = probe.read(servo_id, servo_id_reg.address, 1)[0][0]
         got_baud = probe.read(servo_id, baud.address, 1)[0][0]

@@ -20,6 +20,8 @@ import threading
 import pytest
 
 import gaitbot.emulator as se
+from gaitbot.bus.bringup import BAUD_WRITE_TRIES, SetupFailed, assign_id_and_baud, survey
+from gaitbot.bus.factory import make_probe_bus
 from gaitbot.bus.recording import decode_goal_frames
 from gaitbot.robot.calibration_file import read_calibration
 from gaitbot.servos import baud_register_value, factory_baudrate
@@ -170,6 +172,55 @@ def test_a_servo_of_another_model_is_refused():
         code, out, err = setup(robot, emulator, [robot.joints[0].name])
         assert code == 2 and "is a XL-320" in err and "the config says XL430-W250" in err, err
         assert emulator.chain.writes == []
+
+
+def assign_with_lost_baud_writes(lost):
+    """assign_id_and_baud on one factory-fresh XL430 (id 1, 57,600 baud) towards the config's first joint, the
+    first ``lost`` Baud Rate writes never reaching the line (a packet lost to noise, or to a host that switched
+    rate before the servo heard it): (the Assignment or the SetupFailed, the servo's id and rate, the writes)."""
+    robot = config("xl430-biped")
+    joint = robot.joints[0]
+    baud = joint.model.control_table["Baud Rate"].address
+    with fresh_emulator(robot, 1, one_at_a_time=False) as emulator:
+        probe = make_probe_bus(robot.bus.backend, robot.bus.protocol, emulator.path, reply_timeout_ms=5)
+        with probe:
+            (found,) = survey(probe, [factory_baudrate(joint.model.name)])[0].found
+            sent = probe.write
+            left = {"lost": lost}
+
+            def write(servo_id, address, data, *, confirm=True):
+                if address == baud and left["lost"]:
+                    left["lost"] -= 1
+                    return 0
+                return sent(servo_id, address, data, confirm=confirm)
+
+            probe.write = write
+            try:
+                outcome = assign_id_and_baud(probe, found, joint.model, joint.id, robot.bus.baudrate)
+            except SetupFailed as failed:
+                outcome = failed
+        with emulator.lock:
+            (unit,) = emulator.chain.units
+            return outcome, (unit.servo_id, unit.rate), robot, joint
+
+
+@pytest.mark.parametrize("lost", [1, BAUD_WRITE_TRIES - 1])
+def test_a_baud_rate_write_the_servo_never_heard_is_sent_again(lost):
+    """The servo still answers at its old rate, so the write was lost: setup writes it again and the servo
+    ends at the config's rate, read back."""
+    assignment, (servo_id, rate), robot, joint = assign_with_lost_baud_writes(lost)
+    assert not isinstance(assignment, SetupFailed), assignment
+    assert (servo_id, rate) == (joint.id, robot.bus.baudrate)
+    assert (assignment.servo_id, assignment.baudrate) == (joint.id, robot.bus.baudrate)
+    value = baud_register_value(joint.model.name, robot.bus.baudrate)
+    assert [w for w in assignment.writes if w[0] == "Baud Rate"] == [("Baud Rate", value)] * (lost + 1)
+
+
+def test_a_servo_that_never_hears_its_baud_rate_write_fails_setup_in_words():
+    failed, (servo_id, rate), robot, joint = assign_with_lost_baud_writes(BAUD_WRITE_TRIES)
+    assert isinstance(failed, SetupFailed)
+    assert rate == factory_baudrate(joint.model.name)  # untouched: nothing reached it
+    assert f"still answers at {rate:,} baud after {BAUD_WRITE_TRIES} writes of its Baud Rate" in str(failed), failed
 
 
 # --------------------------------------------------------------------------- calibrate
