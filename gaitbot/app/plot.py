@@ -69,6 +69,7 @@ def run(args) -> int:
         return 0
     write_output(out, lambda path: plot_trajectory(trajectory, source.geometry, path, clearance=source.settings.clearance,
                                                    title=Path(args.file).name, terrain=terrain))
-    ground = "" if terrain is None else f", on a course of {len(terrain.treads)} treads"
+    ground = "" if terrain is None else \
+        f", on a course of {len(terrain.treads)} tread{'' if len(terrain.treads) == 1 else 's'}"
     print(f"wrote {out} (the feet drawn for {walked_by(source)}{ground})")
     return 0
