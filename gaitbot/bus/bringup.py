@@ -11,11 +11,12 @@ order, and nothing else (the e-Manual's "ID" and "Baud Rate" control-table entri
 2. Feetech only: Lock = 0, confirmed (with the lock on, EEPROM writes take effect but are lost at
    power-off);
 3. ID = the new id, at the old id, not waited for (whether the servo answers as its old or its new self
-   is not documented); then a PING at the new id confirms it;
+   is not documented); then a PING at the new id confirms it (if the old id answers instead, the write
+   was lost and is sent again, as in step 4);
 4. Baud Rate = the new rate's register value, at the new id, not waited for (the answer may come at either
    rate); once the write has left the port (and 10 ms more) the host switches to the new rate and PINGs;
    if only the old rate answers, the servo never heard the write (it is sent unconfirmed, so noise or a
-   busy host that switched too soon loses it) and it is written again, up to BAUD_WRITE_TRIES times;
+   busy host that switched too soon loses it) and it is written again, up to WRITE_TRIES times;
 5. read back ID, Baud Rate and Model Number at the new id and rate; Feetech: Lock = 1 again (its
    power-on state; the id and rate written while it was 0 are saved).
 """
@@ -33,8 +34,8 @@ from gaitbot.servos.models import ServoModel
 from gaitbot.servos.status import describe_status_error, hardware_error_bits
 
 
-#: Baud Rate writes sent before setup gives up on a servo that still answers at its old rate.
-BAUD_WRITE_TRIES = 3
+#: ID or Baud Rate writes sent before setup gives up on a servo that still answers as its old self.
+WRITE_TRIES = 3
 
 
 class SetupFailed(BusError):
@@ -95,24 +96,29 @@ def assign_id_and_baud(probe: ProbeBus, found: ServoFound, model: ServoModel, ne
     if lock is not None:
         write("Lock", lock.address, 0)
     if new_id != servo_id:
-        write("ID", servo_id_reg.address, new_id, confirm=False)
-        if not probe.ping(new_id):
+        heard = _until_heard(lambda: write("ID", servo_id_reg.address, new_id, confirm=False),
+                             lambda: probe.ping(new_id), lambda: probe.ping(servo_id))
+        if heard is None:
             raise SetupFailed(f"wrote id {new_id} to servo {servo_id} at {found.baudrate:,} baud, but nothing answers "
                               f"at id {new_id}; run setup again for this joint", servo_id=servo_id)
+        if not heard:
+            raise SetupFailed(f"servo {servo_id} still answers at id {servo_id} after {WRITE_TRIES} writes of its "
+                              f"ID ({new_id}); check its cable and run setup again for this joint", servo_id=servo_id)
         servo_id = new_id
     if new_baudrate != found.baudrate:
-        for _ in range(BAUD_WRITE_TRIES):
+        def send_rate() -> None:
+            probe.set_baudrate(found.baudrate)
             write("Baud Rate", baud.address, value, confirm=False)
             probe.drain()  # the write must leave at the old rate before the host switches
-            probe.set_baudrate(new_baudrate)
-            if probe.ping(servo_id):
-                break
-            probe.set_baudrate(found.baudrate)  # not heard at the new rate: did the write reach it at all?
-            if not probe.ping(servo_id):
-                probe.set_baudrate(new_baudrate)
-                break  # silent at both rates: the read-back below says so
-        else:
-            raise SetupFailed(f"servo {servo_id} still answers at {found.baudrate:,} baud after {BAUD_WRITE_TRIES} "
+
+        def answers_at(rate: int) -> bool:
+            probe.set_baudrate(rate)
+            return probe.ping(servo_id)
+
+        heard = _until_heard(send_rate, lambda: answers_at(new_baudrate), lambda: answers_at(found.baudrate))
+        probe.set_baudrate(new_baudrate)  # silent at both rates (None): the read-back below says so
+        if heard is False:
+            raise SetupFailed(f"servo {servo_id} still answers at {found.baudrate:,} baud after {WRITE_TRIES} "
                               f"writes of its Baud Rate ({value}, {new_baudrate:,} baud); check its cable and run "
                               "setup again for this joint", servo_id=servo_id)
     try:
@@ -129,6 +135,19 @@ def assign_id_and_baud(probe: ProbeBus, found: ServoFound, model: ServoModel, ne
     if lock is not None:
         write("Lock", lock.address, 1)
     return Assignment(found, servo_id, new_baudrate, tuple(writes))
+
+
+def _until_heard(send: Callable[[], None], heard: Callable[[], bool], still_old: Callable[[], bool]) -> bool | None:
+    """Send an unconfirmed write until the servo answers as its new self (``heard``): True. When it answers
+    as its old self (``still_old``) it never heard the write, which is sent again, WRITE_TRIES in all
+    (False: it never did); None when it answers as neither."""
+    for _ in range(WRITE_TRIES):
+        send()
+        if heard():
+            return True
+        if not still_old():
+            return None
+    return False
 
 
 @dataclass(frozen=True)

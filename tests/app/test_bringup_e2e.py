@@ -20,7 +20,7 @@ import threading
 import pytest
 
 import gaitbot.emulator as se
-from gaitbot.bus.bringup import BAUD_WRITE_TRIES, SetupFailed, assign_id_and_baud, survey
+from gaitbot.bus.bringup import WRITE_TRIES, SetupFailed, assign_id_and_baud, survey
 from gaitbot.bus.factory import make_probe_bus
 from gaitbot.bus.recording import decode_goal_frames
 from gaitbot.robot.calibration_file import read_calibration
@@ -174,25 +174,27 @@ def test_a_servo_of_another_model_is_refused():
         assert emulator.chain.writes == []
 
 
-def assign_with_lost_baud_writes(lost):
-    """assign_id_and_baud on one factory-fresh XL430 (id 1, 57,600 baud) towards the config's first joint, the
-    first ``lost`` Baud Rate writes never reaching the line (a packet lost to noise, or to a host that switched
-    rate before the servo heard it): (the Assignment or the SetupFailed, the servo's id and rate, the writes)."""
+def assign_with_lost_writes(register, lost):
+    """assign_id_and_baud on one factory-fresh XL430 (id 1, 57,600 baud) towards the config's second joint (id 2,
+    1,000,000 baud), the first ``lost`` writes of ``register`` (ID or Baud Rate) never reaching the line (a
+    packet lost to noise, or to a host that switched rate before the servo heard it): (the Assignment or the
+    SetupFailed, the servo's id and rate, the robot, the joint)."""
     robot = config("xl430-biped")
-    joint = robot.joints[0]
-    baud = joint.model.control_table["Baud Rate"].address
+    joint = robot.joints[1]
+    address = joint.model.control_table[register].address
     with fresh_emulator(robot, 1, one_at_a_time=False) as emulator:
         probe = make_probe_bus(robot.bus.backend, robot.bus.protocol, emulator.path, reply_timeout_ms=5)
         with probe:
             (found,) = survey(probe, [factory_baudrate(joint.model.name)])[0].found
+            assert (found.servo_id, joint.id) == (1, 2)  # both registers need writing
             sent = probe.write
             left = {"lost": lost}
 
-            def write(servo_id, address, data, *, confirm=True):
-                if address == baud and left["lost"]:
+            def write(servo_id, at, data, *, confirm=True):
+                if at == address and left["lost"]:
                     left["lost"] -= 1
                     return 0
-                return sent(servo_id, address, data, confirm=confirm)
+                return sent(servo_id, at, data, confirm=confirm)
 
             probe.write = write
             try:
@@ -204,23 +206,28 @@ def assign_with_lost_baud_writes(lost):
             return outcome, (unit.servo_id, unit.rate), robot, joint
 
 
-@pytest.mark.parametrize("lost", [1, BAUD_WRITE_TRIES - 1])
-def test_a_baud_rate_write_the_servo_never_heard_is_sent_again(lost):
-    """The servo still answers at its old rate, so the write was lost: setup writes it again and the servo
-    ends at the config's rate, read back."""
-    assignment, (servo_id, rate), robot, joint = assign_with_lost_baud_writes(lost)
+@pytest.mark.parametrize("register", ["ID", "Baud Rate"])
+@pytest.mark.parametrize("lost", [1, WRITE_TRIES - 1])
+def test_an_id_or_baud_rate_write_the_servo_never_heard_is_sent_again(register, lost):
+    """The servo still answers as its old self, so the write was lost: setup writes it again and the servo
+    ends at the config's id and rate, read back."""
+    assignment, (servo_id, rate), robot, joint = assign_with_lost_writes(register, lost)
     assert not isinstance(assignment, SetupFailed), assignment
     assert (servo_id, rate) == (joint.id, robot.bus.baudrate)
     assert (assignment.servo_id, assignment.baudrate) == (joint.id, robot.bus.baudrate)
-    value = baud_register_value(joint.model.name, robot.bus.baudrate)
-    assert [w for w in assignment.writes if w[0] == "Baud Rate"] == [("Baud Rate", value)] * (lost + 1)
+    value = joint.id if register == "ID" else baud_register_value(joint.model.name, robot.bus.baudrate)
+    assert [w for w in assignment.writes if w[0] == register] == [(register, value)] * (lost + 1)
 
 
-def test_a_servo_that_never_hears_its_baud_rate_write_fails_setup_in_words():
-    failed, (servo_id, rate), robot, joint = assign_with_lost_baud_writes(BAUD_WRITE_TRIES)
+@pytest.mark.parametrize("register, words", [("ID", "still answers at id 1 after {n} writes of its ID (2)"),
+                                             ("Baud Rate", "still answers at 57,600 baud after {n} writes of its "
+                                                           "Baud Rate (3, 1,000,000 baud)")])
+def test_a_servo_that_never_hears_its_id_or_baud_rate_write_fails_setup_in_words(register, words):
+    """Words and numbers from the XL430's e-Manual: factory id 1 at 57,600 baud; Baud Rate 3 is 1 Mbaud."""
+    failed, (servo_id, rate), robot, joint = assign_with_lost_writes(register, WRITE_TRIES)
     assert isinstance(failed, SetupFailed)
-    assert rate == factory_baudrate(joint.model.name)  # untouched: nothing reached it
-    assert f"still answers at {rate:,} baud after {BAUD_WRITE_TRIES} writes of its Baud Rate" in str(failed), failed
+    assert words.format(n=WRITE_TRIES) in str(failed), failed
+    assert rate == 57_600 and servo_id == (1 if register == "ID" else 2)  # what it heard, and nothing else
 
 
 # --------------------------------------------------------------------------- calibrate
