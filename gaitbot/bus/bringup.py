@@ -71,8 +71,8 @@ class Assignment:
 def assign_id_and_baud(probe: ProbeBus, found: ServoFound, model: ServoModel, new_id: int,
                        new_baudrate: int) -> Assignment:
     """Give the servo ``found`` the id ``new_id`` and the rate ``new_baudrate`` (the module docstring's steps),
-    then read both back. ValueError when the model cannot hold the rate; SetupFailed when the read-back
-    disagrees; ServoTimeout when the servo stops answering."""
+    then read both back. ValueError when the model cannot hold the rate; SetupFailed when the servo never
+    hears a write or the read-back disagrees; ServoTimeout when the servo stops answering."""
     value = baud_register_value(model.name, new_baudrate)
     if value is None:
         rates = ", ".join(f"{r:,}" for r in baud_rates(model.name).values())
