@@ -110,13 +110,16 @@ def test_each_unanswered_read_asks_for_a_length_of_its_own():
 
 
 def test_the_wait_never_outlasts_its_budget():
+    """The quickest of three missed reads: a busy host may hold any one of them back, but only a wait of the
+    SDK's own timeout (34 ms) holds all three past the budget plus scheduling."""
     bus, port = open_bus(SilentRealTimePort)
     port.silent = {2}
-    start = time.monotonic()
-    result = bus.read_back(2, 0.008)
-    elapsed = time.monotonic() - start
-    assert result.outcome == "missed"
-    assert elapsed < 0.008 + 0.02  # the budget plus scheduling; the SDK's own timeout would be 34 ms
+    elapsed = []
+    for _ in range(3):
+        start = time.monotonic()
+        assert bus.read_back(2, 0.008).outcome == "missed"
+        elapsed.append(time.monotonic() - start)
+    assert min(elapsed) < 0.008 + 0.02, elapsed
     assert bus.read_back(1, 0.008).outcome == "answered"
 
 
