@@ -39,7 +39,7 @@ WRITE_TRIES = 3
 
 
 class SetupFailed(BusError):
-    """A servo did not take its new id or baud rate (the read-back disagrees)."""
+    """A servo did not take its new id or baud rate (a write it never heard, or a read-back that disagrees)."""
 
 
 def survey(probe: ProbeBus, baudrates: Sequence[int], on_baud: Callable[[ProbeResult], None] | None = None,
@@ -101,7 +101,7 @@ def assign_id_and_baud(probe: ProbeBus, found: ServoFound, model: ServoModel, ne
         if heard is None:
             raise SetupFailed(f"wrote id {new_id} to servo {servo_id} at {found.baudrate:,} baud, but nothing answers "
                               f"at id {new_id}; run setup again for this joint", servo_id=servo_id)
-        if not heard:
+        if heard is False:
             raise SetupFailed(f"servo {servo_id} still answers at id {servo_id} after {WRITE_TRIES} writes of its "
                               f"ID ({new_id}); check its cable and run setup again for this joint", servo_id=servo_id)
         servo_id = new_id

@@ -90,7 +90,8 @@ def test_plot_draws_the_files_course(capsys, files, tmp_path, monkeypatch):
                         lambda trajectory, geometry, path, **kw: seen.update(kw) or Path(path).write_bytes(b"png"))
     code, out, err = run_cli(capsys, "plot", files["ditch.csv"], "-o", tmp_path / "s.png")
     assert code == 0, err
-    assert seen["terrain"].treads == load_course(DITCH).terrain.treads and "on a course of 1 tread)" in out  # the ditch's one
+    assert seen["terrain"].treads == load_course(DITCH).terrain.treads
+    assert "on a course of 1 tread)" in out  # the ditch's one
 
 
 def test_contradicting_robot_or_terrain_is_refused(capsys, files, tmp_path):
