@@ -40,14 +40,22 @@ def test_cell_centres():
 
 
 def bowl(centre, scale=(1.0, 3.0)):
-    return lambda p: 1.0 + scale[0] * (p[0] - centre[0]) ** 2 + scale[1] * (p[1] - centre[1]) ** 2
+    return lambda p: 1.0 + scale[0] * (p[:, 0] - centre[0]) ** 2 + scale[1] * (p[:, 1] - centre[1]) ** 2
+
+
+def everywhere(points):
+    return np.ones(len(points), bool)
+
+
+def nowhere(points):
+    return np.zeros(len(points), bool)
 
 
 @pytest.mark.parametrize("centre", [(0.13, 0.21), (0.77, -0.33), (0.5, 0.0), (0.05, 0.45)])
 def test_two_level_search_close_to_brute_force_with_far_fewer_cells(centre):
     cost = bowl(centre)
-    fast = two_level_search(REGION, cost, lambda p: True)
-    full = brute_force(REGION, cost, lambda p: True, n=25)
+    fast = two_level_search(REGION, cost, everywhere)
+    full = brute_force(REGION, cost, everywhere, n=25)
     assert fast.full_grid == 625 and full.evaluated == 625
     assert 50 <= fast.evaluated <= 75
     assert fast.cost <= 1.05 * full.cost
@@ -55,18 +63,18 @@ def test_two_level_search_close_to_brute_force_with_far_fewer_cells(centre):
 
 
 def test_beats_the_middle_of_the_region():
-    result = two_level_search(REGION, bowl((0.2, -0.3)), lambda p: True)
+    result = two_level_search(REGION, bowl((0.2, -0.3)), everywhere)
     assert result.cost < result.centre_cost
 
 
 def test_unreachable_cells_are_skipped_not_scored():
     scored = []
 
-    def cost(p):
-        scored.append(tuple(p))
-        return 1.0 + (p[0] - 0.8) ** 2
+    def cost(points):
+        scored.extend(map(tuple, points))
+        return 1.0 + (points[:, 0] - 0.8) ** 2
 
-    reachable = lambda p: p[1] < 0.0  # noqa: E731  upper half out of reach
+    reachable = lambda p: p[:, 1] < 0.0  # noqa: E731  upper half out of reach
     result = two_level_search(REGION, cost, reachable)
     assert result.pruned >= 10 and result.evaluated < 75
     assert all(y < 0.0 for _, y in scored)
@@ -74,16 +82,18 @@ def test_unreachable_cells_are_skipped_not_scored():
 
 
 def test_nothing_reachable_gives_inf():
-    result = two_level_search(REGION, bowl((0.5, 0.0)), lambda p: False)
+    result = two_level_search(REGION, bowl((0.5, 0.0)), nowhere)
     assert not np.isfinite(result.cost) and result.evaluated == 0 and result.pruned == 25
 
 
 def test_an_optimum_across_the_edge_of_the_best_cell_is_followed():
     """The best point presses against the edge of the feasible part (x < 0.63), in a first-level cell whose
     centre (x = 0.7) is infeasible: the second level follows it across the edge of the best cell."""
-    cost = lambda p: 1.0 + 3.0 * (0.5 - p[1]) + 5.0 * (0.63 - p[0]) if p[0] < 0.63 else np.inf  # noqa: E731
-    full = brute_force(REGION, cost, lambda p: True, n=25)
-    plain = two_level_search(REGION, cost, lambda p: True, follow=0)
-    fast = two_level_search(REGION, cost, lambda p: True)
+    def cost(p):
+        return np.where(p[:, 0] < 0.63, 1.0 + 3.0 * (0.5 - p[:, 1]) + 5.0 * (0.63 - p[:, 0]), np.inf)
+
+    full = brute_force(REGION, cost, everywhere, n=25)
+    plain = two_level_search(REGION, cost, everywhere, follow=0)
+    fast = two_level_search(REGION, cost, everywhere)
     assert plain.cost > 1.05 * full.cost  # a centre-only second level stays in the wrong cell
     assert fast.cost <= 1.05 * full.cost and fast.evaluated <= 75

@@ -14,6 +14,7 @@ import pytest
 from gaitbot.check.trajectory import check_trajectory
 from gaitbot.app.cli import main
 from gaitbot.gait.terrain.model import Terrain, Tread
+from gaitbot.gait.terrain.swing import warp_table
 from gaitbot.gait.terrain.walk import plan_terrain_walk
 from gaitbot.gait.walker import make_context
 from gaitbot.robot.config import load_robot_config
@@ -249,6 +250,45 @@ def test_grid_search_beats_the_middle_and_nears_brute_force(stairs_walk):
         full = problem.brute_force(25)
         assert fast.cost <= 1.05 * full.cost
         assert fast.evaluated <= 75 < full.evaluated + full.pruned
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("stairs-xl430")
+def test_a_level_of_cells_scores_as_each_cell_alone(stairs_walk):
+    """The search scores a level's cells in one batch (the swing's tip fitted for all their pelvis paths at
+    once); each cell's cost must be exactly what it scores alone, feasible or not, on every MDS point."""
+    _, walk, _ = stairs_walk
+    rng = np.random.default_rng(3)
+    for problem in walk.search_problems:
+        x0, x1, y0, y1 = problem.region
+        points = np.column_stack([rng.uniform(x0, x1, 12), rng.uniform(y0, y1, 12)])
+        together = problem.cost(points)
+        alone = np.array([problem.cost(p[None])[0] for p in points])
+        np.testing.assert_array_equal(together, alone)
+        np.testing.assert_array_equal(problem.reachable(points), [problem.reachable(p[None])[0] for p in points])
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("stairs-xl430")
+def test_swing_feet_fitted_together_are_each_as_fitted_alone(stairs_walk):
+    """The swing's sole, tipped and lifted for many hip paths in one batch (a path's timings settle their
+    lift together, paths apart), is exactly what each path gets alone. Hips lowered 0 to 3 cm below the
+    walk's bend the knee until the sole must tip and lift: some paths need no lift, some several rounds."""
+    _, walk, _ = stairs_walk
+    steps = [s for s in (getattr(seg, "inner", seg) for seg in walk.segments) if hasattr(s, "swing_times")]
+    s, sigma = np.linspace(0.0, 1.0, 31), warp_table(1.0, 31)
+    lifted = 0
+    for step in steps:
+        hips = step.pelvis(step.swing_times(1.0, 31))
+        paths = np.stack([hips - [0.0, drop] for drop in np.linspace(0.0, 0.03, 7)])
+        rows = np.broadcast_to(paths[:, None], (len(paths), len(sigma), len(s), 2))
+        poses, lift = step.swing.fitted(s, sigma, rows, paths=len(paths))
+        for k, hip in enumerate(rows):
+            alone = step.swing.fitted(s, sigma, hip)
+            np.testing.assert_array_equal(poses[k * len(sigma):(k + 1) * len(sigma)], alone[0])
+            np.testing.assert_array_equal(lift[k * len(sigma):(k + 1) * len(sigma)], alone[1])
+        lifted += len({round(x, 9) for x in lift.reshape(len(paths), -1).max(axis=1)}) > 2
+    assert lifted >= 2  # the batches did hold paths that settle their lift in different rounds
 
 
 def test_cli_plan_generate_plot(tmp_path, capsys):

@@ -64,8 +64,9 @@ def _slope(a: Knot, b: Knot) -> float:
 class MdsProblem:
     """One MDS point's search: the region and the functions Zhang's grid search needs.
 
-    ``cost(point)`` is the supporting legs' weighted squared joint accelerations (inf where the
-    path is infeasible); ``reachable(point)`` the cheap test at the MDS pose itself."""
+    ``cost(points)`` is, per point (m, 2), the supporting legs' weighted squared joint accelerations
+    (INFEASIBLE and more where the path is infeasible); ``reachable(points)`` the cheap test at the MDS
+    pose itself."""
 
     step_index: int
     region: Region
@@ -151,22 +152,26 @@ class TerrainRun:
                 right[inside], left[inside], sup_r[inside], sup_l[inside] = stance, other, True, other_sup
         return left, right, sup_l, sup_r
 
-    def _supports_excess(self, roots, feet, angles: list | None = None) -> float:
-        """How far the pelvis samples are from feasible for the supporting feet (0 if they all fit): each
-        supporting foot within its leg's reach and ranges, and the pelvis never turning back (it may still
-        be moving backward at the start, as handed over, but once it moves forward it keeps doing so: no
-        loops). The legs' angles (left, right) are appended to ``angles`` if given."""
+    def _supports_excess(self, roots, feet):
+        """How far each pelvis path, sampled at ``roots`` (m, n, 2), is from feasible for the supporting feet
+        (0 if they all fit): each supporting foot within its leg's reach and ranges, and the pelvis never
+        turning back (it may still be moving backward at the start, as handed over, but once it moves
+        forward it keeps doing so: no loops). Returns (m,) excesses and the legs' angles (left, right),
+        each (m, n, 3)."""
         left, right, sup_l, sup_r = feet
-        dx = np.diff(roots[:, 0])
-        forward = np.nonzero(dx >= 0.0)[0]
-        total = float(-np.minimum(dx[forward[0]:] + BACKWARD_TOL, 0.0).sum()) if len(forward) else 0.0
+        m, n = roots.shape[:2]
+        total = np.zeros(m)
+        for i, path in enumerate(roots):
+            dx = np.diff(path[:, 0])
+            forward = np.nonzero(dx >= 0.0)[0]
+            total[i] = float(-np.minimum(dx[forward[0]:] + BACKWARD_TOL, 0.0).sum()) if len(forward) else 0.0
         total /= self.ctx.geometry.leg_length
+        angles = []
         for pose, sup in ((left, sup_l), (right, sup_r)):
-            excess, q = self.legs.check(pose, roots)
-            total += float(excess[sup].sum())
-            if angles is not None:
-                angles.append(q)
-        return total
+            excess, q = self.legs.check(np.tile(pose, (m, 1)), roots.reshape(-1, 2))
+            total += [float(row[sup].sum()) for row in excess.reshape(m, n)]
+            angles.append(q.reshape(m, n, 3))
+        return total, angles
 
     # --- knots ---------------------------------------------------------------------------------------
     def _ms_candidates(self, seg: TerrainStepSegment) -> list[Knot]:
@@ -243,7 +248,7 @@ class TerrainRun:
             end = Knot(t_end, (float(x), float(y)), (_slope(last_ms, Knot(t_end, (x, y), (0, 0), "")), 0.0), "end")
             if not self.knot_legs.fits(handed, np.array([[x, y], [x, y]])).all():
                 continue  # the segment taking over (the flat walker, or the settle) wants room to move on
-            if self._supports_excess(PelvisPath([last_ms, end])(t), feet) > 0.0:
+            if self._supports_excess(PelvisPath([last_ms, end])(t)[None], feet)[0][0] > 0.0:
                 continue
             w, excess = seg.feasible_warp(PelvisPath([*head, last_ms, end]), self.swing_legs)
             if excess <= 0.0:
@@ -305,25 +310,28 @@ class TerrainRun:
             v = monotone_slope((p[0] - prev.pos[0]) / (t_mds - prev.t), (nxt.pos[0] - p[0]) / (nxt.t - t_mds))
             return Knot(t_mds, (float(p[0]), float(p[1])), (v, 0.0), "MDS")
 
-        def reachable(p) -> bool:
-            root = np.asarray(p, dtype=float)[None, :]
-            return bool(self.legs.fits(at_mds[0], root).all() and self.legs.fits(at_mds[1], root).all())
+        def reachable(points) -> np.ndarray:
+            return self.legs.fits(at_mds[0], points) & self.legs.fits(at_mds[1], points)
 
-        def swings_excess(path: PelvisPath) -> float:
-            total = seg.feasible_warp(path, self.swing_legs, s_to=0.5)[1]
-            return total + (before.feasible_warp(path, self.swing_legs)[1] if before is not None else 0.0)
+        def swings_excess(paths: list[PelvisPath]) -> np.ndarray:
+            total = np.zeros(len(paths))
+            for swing, s_to in ((seg, 0.5), (before, 1.0)):
+                if swing is not None:
+                    hips = np.stack([path(swing.swing_times(s_to)) for path in paths])
+                    total += [excess for _, excess in swing.feasible_warps(hips, self.swing_legs, s_to)]
+            return total
 
-        def cost(p) -> float:
-            path = PelvisPath([*head, prev, knot(p), nxt])
-            roots = path(t)
-            angles: list = []
-            excess = self._supports_excess(roots, feet, angles) + swings_excess(path)
-            total = 0.0
+        def cost(points) -> np.ndarray:
+            paths = [PelvisPath([*head, prev, knot(p), nxt]) for p in points]
+            excess, angles = self._supports_excess(np.stack([path(t) for path in paths]), feet)
+            excess += swings_excess(paths)
+            totals = np.zeros(len(paths))
             for q, sup in zip(angles, (sup_l, sup_r)):
-                excess += float(self.legs.motion_excess(q[None], dt, sup[None])[0])
-                acc = (q[2:] - 2 * q[1:-1] + q[:-2]) / dt**2
-                total += float(((acc**2 @ w) * sup[1:-1]).sum() * dt)
-            return INFEASIBLE * (1.0 + excess) if excess > 0.0 else total
+                excess += self.legs.motion_excess(q, dt, np.broadcast_to(sup, q.shape[:2]))
+                for i, qi in enumerate(q):
+                    acc = (qi[2:] - 2 * qi[1:-1] + qi[:-2]) / dt**2
+                    totals[i] += float(((acc**2 @ w) * sup[1:-1]).sum() * dt)
+            return np.where(excess > 0.0, INFEASIBLE * (1.0 + excess), totals)
 
         problem = MdsProblem(k, region, cost, reachable)
         result = problem.search()

@@ -9,6 +9,10 @@ as in a full 25 x 25 search, but far fewer are scored: ``SearchResult`` counts t
 
 ``brute_force`` scores every centre of an n x n grid over the same region: the reference the
 two-level search is tested against.
+
+Both take ``cost`` and ``reachable`` on arrays of points, (m, 2) -> (m,): a level's cells are tested and
+scored together, so a search costs a few array computations per level rather than one per cell (the
+terrain walker's cost builds a pelvis path per cell and checks its legs over every sample).
 """
 
 from __future__ import annotations
@@ -41,18 +45,21 @@ def cell_centres(region: Region, n: int) -> np.ndarray:
 
 def _score(points, cost: Callable, reachable: Callable):
     costs = np.full(len(points), np.inf)
-    evaluated = pruned = 0
-    for i, p in enumerate(points):
-        if not reachable(p):
-            pruned += 1
-            continue
-        evaluated += 1
-        costs[i] = cost(p)
-    return costs, evaluated, pruned
+    ok = np.asarray(reachable(points), dtype=bool)
+    if ok.any():
+        costs[ok] = cost(points[ok])
+    return costs, int(ok.sum()), int((~ok).sum())
+
+
+def _centre_cost(region: Region, cost: Callable, reachable: Callable) -> float:
+    x0, x1, y0, y1 = region
+    centre = np.array([[(x0 + x1) / 2, (y0 + y1) / 2]])
+    return float(cost(centre)[0]) if reachable(centre)[0] else np.inf
 
 
 def two_level_search(region: Region, cost: Callable, reachable: Callable, n: int = 5, follow: int = 1) -> SearchResult:
-    """Zhang's search: ``cost(point)`` -> float (inf if infeasible), ``reachable(point)`` -> bool (cheap).
+    """Zhang's search: ``cost(points)`` -> (m,) floats (inf where infeasible), ``reachable(points)`` -> (m,)
+    bools (cheap), for points (m, 2).
 
     Level one scores the n x n cell centres of the region; level two splits the best cell n x n
     again and scores those. Where the best of the second level lies in the outer ring of its cell,
@@ -84,10 +91,8 @@ def two_level_search(region: Region, cost: Callable, reachable: Callable, n: int
                     if across != (i, j) and 0 <= across[0] < n and 0 <= across[1] < n and follow > 0:
                         queue.append(across)
                         follow -= 1
-    centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
-    centre_cost = float(cost(centre)) if reachable(centre) else np.inf
     point = (float(best_point[0]), float(best_point[1])) if np.isfinite(best_cost) else (np.nan, np.nan)
-    return SearchResult(point, best_cost, evaluated, pruned, n ** 4, centre_cost)
+    return SearchResult(point, best_cost, evaluated, pruned, n ** 4, _centre_cost(region, cost, reachable))
 
 
 def brute_force(region: Region, cost: Callable, reachable: Callable, n: int = 25) -> SearchResult:
@@ -95,8 +100,5 @@ def brute_force(region: Region, cost: Callable, reachable: Callable, n: int = 25
     points = cell_centres(region, n)
     costs, evaluated, pruned = _score(points, cost, reachable)
     k = int(np.argmin(costs))
-    x0, x1, y0, y1 = region
-    centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
-    centre_cost = float(cost(centre)) if reachable(centre) else np.inf
     return SearchResult((float(points[k][0]), float(points[k][1])), float(costs[k]), evaluated, pruned, n * n,
-                        centre_cost)
+                        _centre_cost(region, cost, reachable))

@@ -165,17 +165,31 @@ class TerrainStepSegment:
         one (its sole tipped for the ankle and lifted to stay clear), so the ankle keeps its range by
         construction and is not checked; a timing whose tipped sole needs more extra lift than
         TIP_LIFT_SHARE of the clearance counts as that much beyond too."""
+        return self.feasible_warps(pelvis(self.swing_times(s_to, samples))[None], legs, s_to, warps)[0]
+
+    def swing_times(self, s_to: float = 1.0, samples: int = 31):
+        """The times (s) at which ``feasible_warp`` samples the swing: lift-off to swing progress ``s_to``."""
+        return self.swing_time(np.linspace(0.0, s_to, samples))
+
+    def feasible_warps(self, roots, legs: LegRange, s_to: float = 1.0, warps=WARPS) -> list:
+        """``feasible_warp`` for many pelvis paths at once (the grid search scores a level's cells together):
+        ``roots`` (p, samples, 2), each path's hip at ``swing_times(s_to, samples)``; p (timing, excess)."""
+        paths, samples = roots.shape[:2]
         s = np.linspace(0.0, s_to, samples)
-        roots = pelvis(self.swing_time(s))
         sigma = warp_table(s_to, samples) if warps is WARPS else np.stack([warp(s, *w) for w in warps])
-        poses, extra = self.swing.fitted(s, sigma, np.broadcast_to(roots, (len(warps), samples, 2)))
-        excess, q = legs.check(poses.reshape(-1, 3), np.tile(roots, (len(warps), 1)), False)
-        excess = excess.reshape(len(warps), samples).sum(axis=1)
+        rows = len(warps) * paths
+        hips = np.broadcast_to(roots[:, None], (paths, len(warps), samples, 2))
+        poses, extra = self.swing.fitted(s, sigma, hips, paths=paths)
+        excess, q = legs.check(poses.reshape(-1, 3), hips.reshape(-1, 2), False)
+        excess = excess.reshape(rows, samples).sum(axis=1)
         excess += np.maximum(extra - TIP_LIFT_SHARE * self.swing.clearance, 0.0) / self.ctx.geometry.leg_length
-        excess += legs.motion_excess(q.reshape(len(warps), samples, 3),
+        excess += legs.motion_excess(q.reshape(rows, samples, 3),
                                      s_to * self.duration * (1.0 - self.u_ds) / (samples - 1))
-        best = int(np.argmax(excess <= 0.0)) if (excess <= 0.0).any() else int(np.argmin(excess))
-        return warps[best], float(excess[best])
+        out = []
+        for row in excess.reshape(paths, len(warps)):
+            best = int(np.argmax(row <= 0.0)) if (row <= 0.0).any() else int(np.argmin(row))
+            out.append((warps[best], float(row[best])))
+        return out
 
     def swing_progress(self, u):
         return np.clip((np.asarray(u, dtype=float) - self.u_ds) / (1.0 - self.u_ds), 0.0, 1.0)

@@ -165,20 +165,25 @@ class SwingPath:
         return max(0.0, float((need[short] / shape[short]).max())) if short.any() else 0.0
 
     # --- the foot for a pelvis -------------------------------------------------------------------
-    def fitted(self, s, sigma, roots, extra=None):
+    def fitted(self, s, sigma, roots, extra=None, paths: int = 1):
         """The foot at swing time shares s (n,) and path positions sigma (w, n) (one row per timing) with the hip
-        at ``roots`` (w, n, 2): the sole tipped where
-        a level one would take the ankle out of its range, lifted by ``extra`` (w,) more or, if None, by
-        the least extra that keeps the tipped sole clear, found here per row of samples (each row one
-        timing). Returns (poses (w, n, 3), extra (w,))."""
+        at ``roots`` (paths * w, n, 2: every timing for each of ``paths`` hip paths, path after path): the sole
+        tipped where a level one would take the ankle out of its range, lifted by ``extra`` (paths * w,) more
+        or, if None, by the least extra that keeps the tipped sole clear, found here per row of samples (each
+        row one timing; a path's timings settle together, as if it were fitted alone). Returns
+        (poses (paths * w, n, 3), extra (paths * w,))."""
         sigma = np.atleast_2d(np.asarray(sigma, dtype=float))
         w, n = sigma.shape
-        flat_sigma = sigma.ravel()
-        roots = np.asarray(roots, dtype=float).reshape(w * n, 2)
+        rows = paths * w
+        flat_sigma = np.tile(sigma.ravel(), paths)
+        roots = np.asarray(roots, dtype=float).reshape(rows * n, 2)
         base, fade, shape = self._along(s, sigma)
+        if paths > 1:
+            base, fade, shape = np.tile(base, (paths, 1)), np.tile(fade, paths), np.tile(shape, paths)
         pose = base.copy()
-        usable = (shape > 1e-9).reshape(w, n)
-        lift = np.zeros(w) if extra is None else np.broadcast_to(np.asarray(extra, dtype=float), (w,))
+        usable = (shape > 1e-9).reshape(rows, n)
+        lift = np.zeros(rows) if extra is None else np.broadcast_to(np.asarray(extra, dtype=float), (rows,))
+        settling = np.ones(paths, bool)
         for round_ in range(1 if extra is not None else FIT_ROUNDS):
             pose[:, 1] = base[:, 1] + np.repeat(lift, n) * shape
             rel = pose[:, :2] - roots
@@ -187,18 +192,24 @@ class SwingPath:
             shank = q[:, 0] - q[:, 1]
             tipped = shank + smooth_clamp(base[:, 2] - shank, self.ankle_lo, self.ankle_hi)
             pose[:, 2] = base[:, 2] + fade * (tipped - base[:, 2])
-            if extra is not None or (round_ == 0 and np.abs(pose[:, 2] - base[:, 2]).max() < 1e-12):
-                break  # given the extra lift, or no tipping needed: no extra lift either
+            if extra is not None:
+                break  # given the extra lift
+            if round_ == 0:  # no tipping needed: no extra lift either
+                settling &= np.abs(pose[:, 2] - base[:, 2]).reshape(paths, w * n).max(axis=1) >= 1e-12
+            if not settling.any():
+                break
             probe = pose.copy()
             probe[:, 1] = base[:, 1]
-            ratio = np.where(usable, (self._need(flat_sigma, probe) / np.where(shape > 1e-9, shape, 1.0)).reshape(w, n),
-                             0.0)
+            need = self._need(flat_sigma, probe) / np.where(shape > 1e-9, shape, 1.0)
+            ratio = np.where(usable, need.reshape(rows, n), 0.0)
             needed = np.maximum(ratio.max(axis=1), 0.0)
-            if np.all(needed <= lift + 1e-7 * self.g.leg_length):
+            settling &= ~np.all((needed <= lift + 1e-7 * self.g.leg_length).reshape(paths, w), axis=1)
+            if not settling.any():
                 break  # the tip at this lift is cleared by it: settled
-            lift = np.maximum(lift, needed) + 1e-6 * self.g.leg_length  # the tip grows with the lift: go up to meet it
+            # the tip grows with the lift: go up to meet it
+            lift = np.where(np.repeat(settling, w), np.maximum(lift, needed) + 1e-6 * self.g.leg_length, lift)
         pose[:, 1] = base[:, 1] + np.repeat(lift, n) * shape
-        return pose.reshape(w, n, 3), lift
+        return pose.reshape(rows, n, 3), lift
 
     def _along(self, s, sigma):
         """The lifted level-sole path, the tip's fade and the lift's shape (``lift_shape``) at time shares s and
