@@ -317,7 +317,8 @@ class TerrainRun:
             total = np.zeros(len(paths))
             for swing, s_to in ((seg, 0.5), (before, 1.0)):
                 if swing is not None:
-                    hips = np.stack([path(swing.swing_times(s_to)) for path in paths])
+                    times = swing.swing_times(s_to)
+                    hips = np.stack([path(times) for path in paths])
                     total += [excess for _, excess in swing.feasible_warps(hips, self.swing_legs, s_to)]
             return total
 
