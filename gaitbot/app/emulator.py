@@ -1,7 +1,7 @@
 """The servo emulator's command line (``python tools/servo_emulator.py``; the engine is gaitbot.emulator).
 
 Opens a pty pair, prints the device path (the end a driver opens) as the first line of its output,
-and answers on it like a chain of servos until Ctrl-C:
+and answers on it like a chain of servos until Ctrl-C or SIGTERM:
 
     python tools/servo_emulator.py --robot config/xl430-biped.toml --log goals.jsonl
     python tools/servo_emulator.py --protocol dxl2 --ids 1-6 --late 3:60
@@ -20,8 +20,11 @@ joints. docs/emulator.md lists every option.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import signal
 import sys
+import threading
 from pathlib import Path
 
 from gaitbot.app.cli import OneLineParser
@@ -346,24 +349,16 @@ def main(argv: list[str] | None = None) -> int:
         print(f"servo_emulator: error: {exc}", file=sys.stderr)
         return 2
     emulator = ServoEmulator(config)
-    print(emulator.path, flush=True)
-    if config.fresh:
-        names = sorted({m.name for m in config.fresh})
-        how = "one at a time (Enter plugs in the next)" if config.one_at_a_time else "all connected"
-        print(f"emulating {len(config.fresh)} factory-fresh {'/'.join(names)} servos (all id 1, factory baud rate), "
-              f"{how}, on {config.backend} protocol {config.protocol}; Ctrl-C to stop", file=sys.stderr, flush=True)
-    else:
-        names = sorted({m.name for m in config.models.values()})
-        kept = f" as kept in {config.state_path}" if config.restored else ""
-        print(f"emulating {len(config.models)} {'/'.join(names)} servos (ids {sorted(config.models)}){kept} on "
-              f"{config.backend} protocol {config.protocol}; Ctrl-C to stop", file=sys.stderr, flush=True)
     try:
-        if config.one_at_a_time:
-            emulator.start()
-            _plug_on_enter(emulator)
-            emulator.wait_closed()
-        else:
-            emulator.serve()
+        with _stopped_by_signals():  # before the path is printed: whoever reads it may signal at once
+            print(emulator.path, flush=True)
+            _print_banner(config)
+            if config.one_at_a_time:
+                emulator.start()
+                _plug_on_enter(emulator)
+                emulator.wait_closed()
+            else:
+                emulator.serve()
     except KeyboardInterrupt:
         pass
     finally:
@@ -374,6 +369,40 @@ def main(argv: list[str] | None = None) -> int:
         print(f"servo_emulator: {emulator.chain.goal_frames} goal frames logged to {config.log_path}",
               file=sys.stderr)
     return 0
+
+
+def _print_banner(config: EmulatorConfig) -> None:
+    """What is emulated, on stderr."""
+    if config.fresh:
+        names = sorted({m.name for m in config.fresh})
+        how = "one at a time (Enter plugs in the next)" if config.one_at_a_time else "all connected"
+        print(f"emulating {len(config.fresh)} factory-fresh {'/'.join(names)} servos (all id 1, factory baud rate), "
+              f"{how}, on {config.backend} protocol {config.protocol}; Ctrl-C to stop", file=sys.stderr, flush=True)
+    else:
+        names = sorted({m.name for m in config.models.values()})
+        kept = f" as kept in {config.state_path}" if config.restored else ""
+        print(f"emulating {len(config.models)} {'/'.join(names)} servos (ids {sorted(config.models)}){kept} on "
+              f"{config.backend} protocol {config.protocol}; Ctrl-C to stop", file=sys.stderr, flush=True)
+
+
+@contextlib.contextmanager
+def _stopped_by_signals():
+    """Ctrl-C (SIGINT) and SIGTERM end the emulator as its banner says, whatever its parent did: a process
+    started in the background of a script inherits SIGINT ignored, and Python then installs no handler of its
+    own (a doc test's emulator so ignored its Ctrl-C). The handlers the caller had are put back."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise KeyboardInterrupt
+
+    old = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
 
 
 def _plug_on_enter(emulator: ServoEmulator) -> None:

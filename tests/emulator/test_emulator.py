@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import select
+import signal
 import time
 
 import pytest
@@ -211,6 +212,34 @@ def test_cli_prints_the_device_path_first_and_the_pty_answers(tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=5)
+
+
+def _ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # as a script's background job (no job control) starts
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_ctrl_c_or_sigterm_ends_it_even_when_started_with_sigint_ignored(tmp_path, signum):
+    """The banner says Ctrl-C stops it: so it must, also when its parent left SIGINT ignored (Python then sets
+    no handler; the docs' tests, run from a background job, found its Ctrl-C ignored). Exit 0, its goal log
+    closed and reported, as after a Ctrl-C in a terminal."""
+    import subprocess
+    import sys
+
+    log = tmp_path / "goals.jsonl"
+    proc = subprocess.Popen([sys.executable, str(ROOT / "tools" / "servo_emulator.py"), "--robot",
+                             str(ROOT / "config" / "xl430-biped.toml"), "--log", str(log)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_ignore_sigint)
+    try:
+        assert proc.stdout.readline().strip().startswith("/dev/")
+        proc.send_signal(signum)
+        assert proc.wait(timeout=20) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert "0 goal frames logged to" in proc.stderr.read()
+    assert log.exists()
 
 
 # --- the scripted hand (gaitbot record's test partner) ------------------------------------------
