@@ -169,7 +169,7 @@ class TerrainRun:
         angles = []
         for pose, sup in ((left, sup_l), (right, sup_r)):
             excess, q = self.legs.check(np.tile(pose, (m, 1)), roots.reshape(-1, 2))
-            total += [float(row[sup].sum()) for row in excess.reshape(m, n)]
+            total += [float(row[sup].sum()) for row in excess.reshape(m, n)]  # row by row: the same bits in any batch
             angles.append(q.reshape(m, n, 3))
         return total, angles
 
@@ -329,7 +329,7 @@ class TerrainRun:
             totals = np.zeros(len(paths))
             for q, sup in zip(angles, (sup_l, sup_r)):
                 excess += self.legs.motion_excess(q, dt, np.broadcast_to(sup, q.shape[:2]))
-                for i, qi in enumerate(q):
+                for i, qi in enumerate(q):  # path by path: a cell scores the same bits in any batch
                     acc = (qi[2:] - 2 * qi[1:-1] + qi[:-2]) / dt**2
                     totals[i] += float(((acc**2 @ w) * sup[1:-1]).sum() * dt)
             return np.where(excess > 0.0, INFEASIBLE * (1.0 + excess), totals)
