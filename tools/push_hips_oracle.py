@@ -30,6 +30,8 @@ import numpy as np
 
 import push_survival
 from gaitbot.feel.feedback import Feedback
+from gaitbot.robot.config import load_robot_config
+from gaitbot.robot.shipped_configs import resolve_config
 from gaitbot.sim.walk import SimWalk
 
 BURST_DEG = 30.0
@@ -43,8 +45,10 @@ out) undoes less of what it caught."""
 OVER_N_S = 1.2
 """The pushes given a burst: the bound's 15 lost pushes without the hips are all of 1.39 N s or more."""
 LATENCY_FRAMES = (2, 3, 4, 6)
-"""When the burst starts after the push does (frames of the op3's 60 Hz)."""
-FRAME_S = 1.0 / 60.0
+"""When the burst starts after the push does (frames of the op3's goal stream)."""
+FRAME_S = 1.0 / load_robot_config(resolve_config("op3")).gait.rate_hz
+DRAWS = push_survival.drawn_pushes(100, 23, 2.0)
+"""tools/push_survival.py's pushes (its defaults: 100 of 0 to 2 N s, seed 23)."""
 WORKERS = 2
 """Processes walking the pushes (the machines this runs on have two cores)."""
 
@@ -102,26 +106,24 @@ def _walk(task: tuple) -> bool:
         return push_survival.one_push("op3", push_survival.WALKS["op3"], impulse, direction, phase, n, "full")["survived"]
 
 
-def survived(runs: list[tuple[int | None, float]], pushes: int = 100, seed: int = 23) -> list[list[bool]]:
-    """For each (latency_frames, over_n_s) of ``runs``, each push of tools/push_survival.py: survived? The walks
-    are independent (each its own session and seeded IMU): WORKERS processes walk them, in any order."""
-    draws = push_survival.drawn_pushes(pushes, seed, 2.0)
-    tasks = [(latency, over, n, draw) for latency, over in runs for n, draw in enumerate(draws, start=1)]
+def survived(runs: list[tuple[int | None, float]]) -> list[list[bool]]:
+    """For each (latency_frames, over_n_s) of ``runs``, each of DRAWS: survived? The walks are independent (each
+    its own session and seeded IMU): WORKERS processes walk them, in any order."""
+    tasks = [(latency, over, n, draw) for latency, over in runs for n, draw in enumerate(DRAWS, start=1)]
     with ProcessPoolExecutor(WORKERS) as pool:
         alive = list(pool.map(_walk, tasks, chunksize=4))
-    return [alive[i * pushes:(i + 1) * pushes] for i in range(len(runs))]
+    return [alive[i * len(DRAWS):(i + 1) * len(DRAWS)] for i in range(len(runs))]
 
 
 def markdown() -> str:
-    draws = push_survival.drawn_pushes(100, 23, 2.0)
-    big = [impulse > OVER_N_S for impulse, _, _ in draws]
+    big = [impulse > OVER_N_S for impulse, _, _ in DRAWS]
     labels = ["none (feedback full as shipped)"]
     labels += [f"{n} frames ({1e3 * n * FRAME_S:.0f} ms) after the push" for n in LATENCY_FRAMES]
     labels.append(f"every push, whatever its size: {LATENCY_FRAMES[0]} frames after it")
     runs = [(None, OVER_N_S), *((n, OVER_N_S) for n in LATENCY_FRAMES), (LATENCY_FRAMES[0], 0.0)]
     rows = list(zip(labels, survived(runs)))
-    lines = [f"| hip burst ({BURST_DEG:g} deg, pushes over {OVER_N_S:g} N s), started | survived of 100 | "
-             f"of the {sum(big)} over {OVER_N_S:g} N s | of the {100 - sum(big)} others |", "|---|---|---|---|"]
+    lines = [f"| hip burst ({BURST_DEG:g} deg, pushes over {OVER_N_S:g} N s), started | survived of {len(DRAWS)} | "
+             f"of the {sum(big)} over {OVER_N_S:g} N s | of the {len(DRAWS) - sum(big)} others |", "|---|---|---|---|"]
     for label, alive in rows:
         lines.append(f"| {label} | {sum(alive)} | {sum(a for a, b in zip(alive, big) if b)} | "
                      f"{sum(a for a, b in zip(alive, big) if not b)} |")

@@ -12,7 +12,7 @@ import push_hips_oracle as ho  # noqa: E402
 import push_survival  # noqa: E402
 from helpers import config  # noqa: E402
 
-PUSH_1 = push_survival.drawn_pushes(1, 23, 2.0)[0]
+PUSH_1 = ho.DRAWS[0]
 """Push 1 of tools/push_survival.py: 1.39 N s backwards and to the right, early in a swing; feedback full loses
 it (docs/feedback.md), and the bound needs the hips to catch it (docs/capturability.md)."""
 
