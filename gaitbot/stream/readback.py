@@ -117,7 +117,9 @@ class ReadBackMonitor:
         budget_ms = max(0.0, budget_s) * 1e3
         late = [m.late_s for m in misses if m.late_s is not None]
         damaged = sum(m.outcome == "damaged" for m in misses)
-        if damaged and not late:
+        # Most misses damaged: the wire. A few late replies beside them are a busy host's or the
+        # emulator's scheduling, and a late servo's replies do not come damaged more often than not.
+        if damaged > len(late):
             some = "" if damaged == count else f"{damaged} of "
             return CorruptReplies(
                 f"servo {servo_id} on {port} sent a damaged status packet (bad checksum/CRC) in {some}{count} "

@@ -228,6 +228,29 @@ def test_late_replies_are_named_as_late():
         run_monitor(Late(clock), clock, 200)
 
 
+@pytest.mark.parametrize("pattern, error, words", [("DDDL", CorruptReplies, "damaged status packet"),
+                                                    ("LLLD", ServoLate, "answers late")])
+def test_mixed_misses_are_named_by_what_most_of_them_were(pattern, error, words):
+    """A servo whose replies come damaged, a few of them also late (a busy host, as under a loaded CI
+    machine), is named for the damage; one whose misses are mostly late, for the lateness."""
+    clock = VirtualClock()
+
+    class Mixed(ScriptedBus):
+        misses = 0
+
+        def read_back(self, servo_id, budget_s):
+            result = super().read_back(servo_id, budget_s)
+            if servo_id != 3:
+                return result
+            self.misses += 1
+            if pattern[(self.misses - 1) % len(pattern)] == "L":
+                return ReadBack(3, "missed", late_s=0.02)
+            return ReadBack(3, "damaged")
+
+    with pytest.raises(error, match=f"servo 3 .*{words}"):
+        run_monitor(Mixed(clock), clock, 200)
+
+
 def test_misses_in_frames_that_started_late_name_no_one_and_every_servo_is_still_read():
     """A host late by 14 ms in every frame leaves each read ~1 ms: a servo missing then is not blamed (the
     host is), and the reading moves on, so a real fault on another servo is still seen."""
