@@ -46,7 +46,15 @@ class ServoLate(ServoTimeout):
 
 
 class CorruptReplies(ServoTimeout):
-    """Every attempt got a damaged status packet (bad checksum/CRC or truncated) from the servo."""
+    """Most attempts got a damaged status packet (bad checksum/CRC or truncated) from the servo."""
+
+
+def miss_kind(late: int, damaged: int, silent: int) -> str:
+    """What a run of failed exchanges with one servo says of it: ``"late"``, ``"damaged"`` or ``"silent"``,
+    whichever most of them were (ties in that order). A few late or damaged replies among many of another
+    kind say more about a busy host or one bad moment than about the servo; both the per-frame read-back
+    and the blocking reads name a servo by this rule (ServoLate, CorruptReplies, ServoTimeout)."""
+    return max((("late", late), ("damaged", damaged), ("silent", silent)), key=lambda kind: kind[1])[0]
 
 
 class ServoStatusError(BusError):

@@ -6,7 +6,7 @@ A mixin of :class:`~gaitbot.bus.sdk_bus.SdkBus` (its port name, SDK, packet hand
 
 from __future__ import annotations
 
-from gaitbot.bus.base import BusError, CorruptReplies, PortError, ServoLate, ServoStatusError, ServoTimeout
+from gaitbot.bus.base import BusError, CorruptReplies, PortError, ServoLate, ServoStatusError, ServoTimeout, miss_kind
 from gaitbot.servos.status import describe_status_error, hardware_error_address
 
 #: An attempt of a blocking exchange whose status packet came during the late-reply watch.
@@ -67,16 +67,19 @@ class FaultReports:
     def _no_answer(self, servo_id: int, results: list, what: str) -> ServoTimeout:
         attempts = len(results)
         result = results[-1]
-        if LATE_REPLY in results:
-            late = sum(r == LATE_REPLY for r in results)
+        late = sum(r == LATE_REPLY for r in results)
+        corrupt = sum(r == self.sdk.COMM_RX_CORRUPT for r in results)
+        kind = miss_kind(late, corrupt, attempts - late - corrupt)
+        if kind == "late":
             return self._late(servo_id, f"in {late} of {attempts} {what}")
-        if all(r == self.sdk.COMM_RX_CORRUPT for r in results):
+        if kind == "damaged":
+            some = "all" if corrupt == attempts else f"{corrupt} of"
             return CorruptReplies(
-                f"servo {servo_id} on {self.port_name} sent a damaged status packet (bad checksum/CRC) in all "
+                f"servo {servo_id} on {self.port_name} sent a damaged status packet (bad checksum/CRC) in {some} "
                 f"{attempts} {what}; check its cable, connectors and the bus wiring",
                 result_code=result, servo_id=servo_id)
-        corrupt = sum(r == self.sdk.COMM_RX_CORRUPT for r in results)
-        how = f" ({corrupt} of the replies damaged)" if corrupt else ""
+        others = [f"{n} {word}" for n, word in ((corrupt, "damaged"), (late, "late")) if n]
+        how = f" (of the replies: {', '.join(others)})" if others else ""
         return ServoTimeout(
             f"servo {servo_id} on {self.port_name} did not return its present position after {attempts} {what}"
             f"{how}: no status packet within the reply timeout; check its power, cable, id and baud rate",

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-from gaitbot.bus.base import Bus, CorruptReplies, ReadBack, ServoLate, ServoTimeout
+from gaitbot.bus.base import Bus, CorruptReplies, ReadBack, ServoLate, ServoTimeout, miss_kind
 from gaitbot.stream.clock import Clock
 
 #: A servo stops the walk when it has missed this many read-backs in a row (no status packet answering
@@ -115,20 +115,22 @@ class ReadBackMonitor:
         port = self.bus.port_name
         count = len(misses)
         budget_ms = max(0.0, budget_s) * 1e3
-        late = [m.late_s for m in misses if m.late_s is not None]
+        # a damaged reply came within its budget: it counts as damaged even if a late reply to an earlier
+        # read was seen beside it (late_s)
         damaged = sum(m.outcome == "damaged" for m in misses)
-        # Most misses damaged: the wire. A few late replies beside them are a busy host's or the
-        # emulator's scheduling, and a late servo's replies do not come damaged more often than not.
-        if damaged > len(late):
+        late = sum(m.late_s is not None and m.outcome != "damaged" for m in misses)
+        kind = miss_kind(late, damaged, count - late - damaged)
+        if kind == "damaged":
             some = "" if damaged == count else f"{damaged} of "
             return CorruptReplies(
                 f"servo {servo_id} on {port} sent a damaged status packet (bad checksum/CRC) in {some}{count} "
                 "read-backs in a row, and no good one; check its cable, connectors and the bus wiring",
                 servo_id=servo_id)
-        if late:
+        if kind == "late":
+            late_ms = max(m.late_s or 0.0 for m in misses) * 1e3
             return ServoLate(
                 f"servo {servo_id} on {port} answers late: {count} read-backs in a row missed their frame's budget "
-                f"(about {budget_ms:.0f} ms), its status packets came {max(late) * 1e3:.0f} ms after the request; "
+                f"(about {budget_ms:.0f} ms), its status packets came {late_ms:.0f} ms after the request; "
                 "check its Return Delay Time and the adapter's latency timer", servo_id=servo_id)
         return ServoTimeout(
             f"servo {servo_id} on {port} did not answer {count} read-backs in a row within their frame's budget "

@@ -229,10 +229,14 @@ def test_late_replies_are_named_as_late():
 
 
 @pytest.mark.parametrize("pattern, error, words", [("DDDL", CorruptReplies, "damaged status packet"),
-                                                    ("LLLD", ServoLate, "answers late")])
+                                                    ("LLLD", ServoLate, "answers late"),
+                                                    ("SSSD", ServoTimeout, "did not answer"),
+                                                    ("XXXL", CorruptReplies, "damaged status packet")])
 def test_mixed_misses_are_named_by_what_most_of_them_were(pattern, error, words):
     """A servo whose replies come damaged, a few of them also late (a busy host, as under a loaded CI
-    machine), is named for the damage; one whose misses are mostly late, for the lateness."""
+    machine), is named for the damage; one whose misses are mostly late, for the lateness; one mostly
+    silent, with a garbled packet now and then, as silent. X: a damaged reply within the budget, a late
+    reply to an earlier read seen beside it (how a corrupting servo looks on a slow host): damaged."""
     clock = VirtualClock()
 
     class Mixed(ScriptedBus):
@@ -243,9 +247,10 @@ def test_mixed_misses_are_named_by_what_most_of_them_were(pattern, error, words)
             if servo_id != 3:
                 return result
             self.misses += 1
-            if pattern[(self.misses - 1) % len(pattern)] == "L":
+            kind = pattern[(self.misses - 1) % len(pattern)]
+            if kind == "L":
                 return ReadBack(3, "missed", late_s=0.02)
-            return ReadBack(3, "damaged")
+            return ReadBack(3, "damaged" if kind in "DX" else "missed", late_s=0.02 if kind == "X" else None)
 
     with pytest.raises(error, match=f"servo 3 .*{words}"):
         run_monitor(Mixed(clock), clock, 200)
