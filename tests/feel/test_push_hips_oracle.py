@@ -9,7 +9,6 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
 import push_hips_oracle as ho  # noqa: E402
-import push_survival  # noqa: E402
 from helpers import config  # noqa: E402
 
 PUSH_1 = ho.DRAWS[0]
@@ -41,17 +40,9 @@ def test_a_forward_burst_flexes_both_hips_and_a_leftward_one_turns_the_pelvis_ab
     assert not np.any(ho.burst_rad(others, 37.0, 1.0))
 
 
-def _walk_push_1() -> bool:
-    impulse, direction, phase = PUSH_1
-    return push_survival.one_push("op3", push_survival.WALKS["op3"], impulse, direction, phase, 1, "full")["survived"]
-
-
 def test_the_oracles_burst_catches_a_push_the_feedback_loses_and_a_burst_away_from_it_does_not(monkeypatch):
     assert PUSH_1[0] > ho.OVER_N_S
-    with ho.oracle(None):
-        assert not _walk_push_1()
-    with ho.oracle(ho.LATENCY_FRAMES[0]):
-        assert _walk_push_1()
+    assert not ho._walk((None, ho.OVER_N_S, 1, PUSH_1))
+    assert ho._walk((ho.LATENCY_FRAMES[0], ho.OVER_N_S, 1, PUSH_1))
     monkeypatch.setattr(ho, "BURST_DEG", -ho.BURST_DEG)  # the same burst, turned away from the push
-    with ho.oracle(ho.LATENCY_FRAMES[0]):
-        assert not _walk_push_1()
+    assert not ho._walk((ho.LATENCY_FRAMES[0], ho.OVER_N_S, 1, PUSH_1))
