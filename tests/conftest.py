@@ -11,7 +11,16 @@ videos, fuzzing, and the other robots, protocols and faults of a behaviour one c
 limit refusal, a signal. Expensive work several tests judge is made once (session or grouped fixtures).
 """
 
+import os
+
 import pytest
+
+# Software OpenGL (Mesa's llvmpipe, what MuJoCo's offscreen renderer gets on a host without a GPU) starts a
+# rasterising thread per core: one video render then takes both cores of a 2-core host and can starve the
+# real-time worker (a likely cause of a CI run in which every frame of an emulator walk went out 53 ms late).
+# Each test, and every command it starts, renders on its own thread instead; a user's renders keep Mesa's
+# default.
+os.environ.setdefault("LP_NUM_THREADS", "0")
 
 #: Modules whose tests run against a servo emulator or a real-time clock: they go to one worker, one at a
 #: time (pytest-xdist's loadgroup), since two real-time walks on a 2-core host delay replies past the SDK's
