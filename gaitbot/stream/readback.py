@@ -33,14 +33,16 @@ READ_BACK_SILENCE_S = 0.5
 #: that started late leaves its read too little time, and such a miss says more about the host than
 #: the servo (the next servo in turn is read then, so every servo keeps being read).
 FAIR_BUDGET_S = 4.0e-3
-#: A servo not heard for this long stops the walk whatever its reads' budgets were, once READ_BACK_MISSES
-#: reads since its last answer went unanswered: on a stream that stays late every read is short, the rule
-#: above blames no one, and a silent servo would go unseen to the end of the walk (a host too busy to hear
-#: its servos for this long is not in control of them either; the message says the frames ran late).
+#: A servo not heard for this long stops the walk, though its reads were short, once READ_BACK_MISSES reads
+#: of at least READ_BACK_FLOOR_S since its last answer went unanswered: on a stream that stays late every
+#: read is short, the rule above blames no one, and a silent servo would go unseen to the end of the walk
+#: (the message says the frames ran late). Reads under the floor, which a busy host's replies often
+#: outlast, do not count.
 READ_BACK_UNHEARD_S = 1.0
-#: When this many frames in a row started too late to leave their read any budget, the next read gets
-#: READ_BACK_FLOOR_S anyway: a stream that stays late (a very busy host) is still watched, and a servo
-#: reporting error bits still stops it; the cost is at most that much more lateness every few frames.
+#: When this many frames in a row started too late to leave their read this floor (no read, or a short one
+#: unanswered), the next read gets READ_BACK_FLOOR_S anyway: a stream that stays late (a very busy host) is
+#: still watched, a servo reporting error bits still stops it and a silent one is still found
+#: (READ_BACK_UNHEARD_S); the cost is at most that much more lateness every few frames.
 SKIPPED_READS_BEFORE_FLOOR = 5
 READ_BACK_FLOOR_S = 2.0e-3
 #: The read-back's budget ends this long before the next frame's deadline: room for the clock's wake-up
@@ -78,7 +80,7 @@ class ReadBackMonitor:
         self.started_s: float | None = None
         self.reads = 0
         self.skipped = 0
-        self.skipped_in_row = 0
+        self.short_in_row = 0  # reads in a row that had under READ_BACK_FLOOR_S and no answer
 
     def budget_s(self, deadline_s: float) -> float:
         return deadline_s + self.period_s - self.margin_s - self.clock.now()
@@ -89,18 +91,19 @@ class ReadBackMonitor:
         else:
             servo_id = self.ids[self.next_index % len(self.ids)]
         budget_s = self.budget_s(deadline_s)
-        if self.skipped_in_row >= SKIPPED_READS_BEFORE_FLOOR:
+        if self.short_in_row >= SKIPPED_READS_BEFORE_FLOOR:
             budget_s = max(budget_s, READ_BACK_FLOOR_S)
         asked_s = self.clock.now()
         if self.started_s is None:
             self.started_s = asked_s
         result = self.bus.read_back(servo_id, budget_s)
         self.reads += 1
+        short = budget_s < READ_BACK_FLOOR_S and result.outcome != "answered"
+        self.short_in_row = self.short_in_row + 1 if short else 0
         if result.outcome == "skipped":
             self.skipped += 1
-            self.skipped_in_row += 1
+        if short:  # too short to tell: the same servo is asked again, and soon with the floor
             return
-        self.skipped_in_row = 0
         if result.outcome == "answered":
             self.missed.pop(servo_id, None)
             self.unanswered.pop(servo_id, None)
@@ -113,7 +116,8 @@ class ReadBackMonitor:
                 self.on_answer(result)
             return
         unanswered = self.unanswered.setdefault(servo_id, [])
-        unanswered.append(result)
+        if budget_s >= READ_BACK_FLOOR_S:
+            unanswered.append(result)
         if budget_s < min(FAIR_BUDGET_S, 0.25 * self.period_s):
             if (len(unanswered) >= self.misses
                     and self.clock.now() - self.heard_s.get(servo_id, self.started_s) >= READ_BACK_UNHEARD_S):

@@ -268,7 +268,6 @@ def test_misses_in_frames_that_started_late_name_no_one_and_every_servo_is_still
         clock.sleep_until(deadline + 0.014)  # every frame starts 14 ms late
         monitor(deadline)
     assert set(bus.reads) == {1, 2, 3, 4, 5, 6}
-    assert max(bus.reads.count(i) for i in range(1, 7)) - min(bus.reads.count(i) for i in range(1, 7)) <= 1
 
 
 def test_a_stream_that_stays_late_is_still_read_back():
@@ -294,19 +293,27 @@ def test_a_stream_that_stays_late_is_still_read_back():
     assert set(bus.reads) == {1, 2, 3}
 
 
-@pytest.mark.parametrize("late_s", [0.014, 0.02], ids=["short reads", "no budget: floor reads"])
+@pytest.mark.parametrize("late_s", [0.012, 0.014, 0.02],
+                         ids=["reads of 2.7 ms", "reads of 0.7 ms: floor reads", "no budget: floor reads"])
 def test_a_silent_servo_on_a_stream_that_stays_late_is_still_stopped_for(late_s):
-    """Every frame late: every read short (14 ms late: ~1 ms left) or skipped but for a floor read every few
-    frames (20 ms late). No miss is fair, yet a servo that goes silent is named once it has not been heard for
+    """Every frame late: every read short (12 ms late: 2.7 ms left), too short to count (14 ms: 0.7 ms) or
+    skipped (20 ms), but for a floor read every few frames in the last two. No miss is fair, yet a servo that goes silent is named once it has not been heard for
     READ_BACK_UNHEARD_S, with READ_BACK_MISSES reads unanswered, the message saying the frames ran late; the
     same stream with every servo answering runs on. (Before this rule, a CI run whose host kept every frame
     53 ms late walked the emulator's silent servo to the end of the walk.)"""
-    class Silent(ScriptedBus):
+    class Slow(ScriptedBus):
+        """Skips a read under 0.5 ms; a reply takes 1 ms, so a shorter read goes unanswered."""
+        silent_from_s = float("inf")
+
         def read_back(self, servo_id, budget_s):
             if budget_s < 0.5e-3:
                 return ReadBack(servo_id, "skipped")
             result = super().read_back(servo_id, budget_s)
-            return ReadBack(3, "missed") if servo_id == 3 and self.clock.now() > 0.5 else result
+            silent = servo_id == 3 and self.clock.now() > self.silent_from_s
+            return ReadBack(servo_id, "missed") if silent or budget_s < 1e-3 else result
+
+    class Silent(Slow):
+        silent_from_s = 0.5
 
     def walk(bus, clock, frames):
         monitor = ReadBackMonitor(bus, [1, 2, 3, 4, 5, 6], clock, 1 / 60)
@@ -315,7 +322,7 @@ def test_a_silent_servo_on_a_stream_that_stays_late_is_still_stopped_for(late_s)
             monitor(k / 60)
 
     clock = VirtualClock()
-    walk(ScriptedBus(clock), clock, 600)  # ten seconds, every servo answering: no stop
+    walk(Slow(clock), clock, 600)  # ten seconds, every servo answering what it can: no stop
     clock = VirtualClock()
     bus = Silent(clock)
     with pytest.raises(ServoTimeout, match=r"servo 3 .*did not answer .*not heard for 1\.\d s: the frames ran late"):
