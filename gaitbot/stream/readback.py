@@ -75,7 +75,7 @@ class ReadBackMonitor:
         self.next_index = 0
         self.suspect: int | None = None  # the servo that missed last: read again until it answers
         self.missed: dict[int, list[ReadBack]] = {}  # servo -> its misses in a row
-        self.unanswered: dict[int, list[ReadBack]] = {}  # servo -> every read since its last answer, any budget
+        self.unanswered: dict[int, list[ReadBack]] = {}  # servo -> its reads of at least the floor since its last answer
         self.heard_s: dict[int, float] = {}  # servo -> its last answer (or the first read-back of all)
         self.started_s: float | None = None
         self.reads = 0
@@ -102,6 +102,7 @@ class ReadBackMonitor:
         self.short_in_row = self.short_in_row + 1 if short else 0
         if result.outcome == "skipped":
             self.skipped += 1
+            return
         if short:  # too short to tell: the same servo is asked again, and soon with the floor
             return
         if result.outcome == "answered":
@@ -116,8 +117,7 @@ class ReadBackMonitor:
                 self.on_answer(result)
             return
         unanswered = self.unanswered.setdefault(servo_id, [])
-        if budget_s >= READ_BACK_FLOOR_S:
-            unanswered.append(result)
+        unanswered.append(result)
         if budget_s < min(FAIR_BUDGET_S, 0.25 * self.period_s):
             if (len(unanswered) >= self.misses
                     and self.clock.now() - self.heard_s.get(servo_id, self.started_s) >= READ_BACK_UNHEARD_S):
