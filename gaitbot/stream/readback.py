@@ -33,16 +33,9 @@ READ_BACK_SILENCE_S = 0.5
 #: that started late leaves its read too little time, and such a miss says more about the host than
 #: the servo (the next servo in turn is read then, so every servo keeps being read).
 FAIR_BUDGET_S = 4.0e-3
-#: A servo not heard for this long stops the walk, though its reads were short, once READ_BACK_MISSES reads
-#: of at least READ_BACK_FLOOR_S since its last answer went unanswered: on a stream that stays late every
-#: read is short, the rule above blames no one, and a silent servo would go unseen to the end of the walk
-#: (the message says the frames ran late). Reads under the floor, which a busy host's replies often
-#: outlast, do not count.
-READ_BACK_UNHEARD_S = 1.0
-#: When this many frames in a row started too late to leave their read this floor (no read, or a short one
-#: unanswered), the next read gets READ_BACK_FLOOR_S anyway: a stream that stays late (a very busy host) is
-#: still watched, a servo reporting error bits still stops it and a silent one is still found
-#: (READ_BACK_UNHEARD_S); the cost is at most that much more lateness every few frames.
+#: When this many frames in a row started too late to leave their read any budget, the next read gets
+#: READ_BACK_FLOOR_S anyway: a stream that stays late (a very busy host) is still watched, and a servo
+#: reporting error bits still stops it; the cost is at most that much more lateness every few frames.
 SKIPPED_READS_BEFORE_FLOOR = 5
 READ_BACK_FLOOR_S = 2.0e-3
 #: The read-back's budget ends this long before the next frame's deadline: room for the clock's wake-up
@@ -75,12 +68,9 @@ class ReadBackMonitor:
         self.next_index = 0
         self.suspect: int | None = None  # the servo that missed last: read again until it answers
         self.missed: dict[int, list[ReadBack]] = {}  # servo -> its misses in a row
-        self.unanswered: dict[int, list[ReadBack]] = {}  # servo -> its reads of at least the floor since its last answer
-        self.heard_s: dict[int, float] = {}  # servo -> its last answer (or the first read-back of all)
-        self.started_s: float | None = None
         self.reads = 0
         self.skipped = 0
-        self.short_in_row = 0  # reads in a row that had under READ_BACK_FLOOR_S and no answer
+        self.skipped_in_row = 0
 
     def budget_s(self, deadline_s: float) -> float:
         return deadline_s + self.period_s - self.margin_s - self.clock.now()
@@ -91,37 +81,26 @@ class ReadBackMonitor:
         else:
             servo_id = self.ids[self.next_index % len(self.ids)]
         budget_s = self.budget_s(deadline_s)
-        if self.short_in_row >= SKIPPED_READS_BEFORE_FLOOR:
+        if self.skipped_in_row >= SKIPPED_READS_BEFORE_FLOOR:
             budget_s = max(budget_s, READ_BACK_FLOOR_S)
         asked_s = self.clock.now()
-        if self.started_s is None:
-            self.started_s = asked_s
         result = self.bus.read_back(servo_id, budget_s)
         self.reads += 1
-        short = budget_s < READ_BACK_FLOOR_S and result.outcome != "answered"
-        self.short_in_row = self.short_in_row + 1 if short else 0
         if result.outcome == "skipped":
             self.skipped += 1
+            self.skipped_in_row += 1
             return
-        if short:  # too short to tell: the same servo is asked again, and soon with the floor
-            return
+        self.skipped_in_row = 0
         if result.outcome == "answered":
             self.missed.pop(servo_id, None)
-            self.unanswered.pop(servo_id, None)
             self.first_miss_s.pop(servo_id, None)
-            self.heard_s[servo_id] = self.clock.now()
             if self.suspect == servo_id:
                 self.suspect = None
             self.next_index += 1
             if self.on_answer is not None:
                 self.on_answer(result)
             return
-        unanswered = self.unanswered.setdefault(servo_id, [])
-        unanswered.append(result)
         if budget_s < min(FAIR_BUDGET_S, 0.25 * self.period_s):
-            if (len(unanswered) >= self.misses
-                    and self.clock.now() - self.heard_s.get(servo_id, self.started_s) >= READ_BACK_UNHEARD_S):
-                raise self.error(servo_id, unanswered, budget_s, ran_late=True)
             if self.suspect != servo_id:
                 self.next_index += 1
             return
@@ -132,9 +111,7 @@ class ReadBackMonitor:
         if len(misses) >= self.misses and self.clock.now() - self.first_miss_s[servo_id] >= self.silence_s:
             raise self.error(servo_id, misses, budget_s)
 
-    def error(self, servo_id: int, misses: list[ReadBack], budget_s: float, ran_late: bool = False) -> ServoTimeout:
-        """The stop naming the servo by what most of its misses were; ``ran_late``: its reads were short
-        because the frames ran late (READ_BACK_UNHEARD_S), which the message says."""
+    def error(self, servo_id: int, misses: list[ReadBack], budget_s: float) -> ServoTimeout:
         port = self.bus.port_name
         count = len(misses)
         budget_ms = max(0.0, budget_s) * 1e3
@@ -145,21 +122,16 @@ class ReadBackMonitor:
         kind = miss_kind(late, damaged, count - late - damaged)
         if kind == "damaged":
             some = "" if damaged == count else f"{damaged} of "
-            error, text = CorruptReplies, (
+            return CorruptReplies(
                 f"servo {servo_id} on {port} sent a damaged status packet (bad checksum/CRC) in {some}{count} "
-                "read-backs in a row, and no good one; check its cable, connectors and the bus wiring")
-        elif kind == "late":
+                "read-backs in a row, and no good one; check its cable, connectors and the bus wiring",
+                servo_id=servo_id)
+        if kind == "late":
             late_ms = max(m.late_s or 0.0 for m in misses) * 1e3
-            error, text = ServoLate, (
+            return ServoLate(
                 f"servo {servo_id} on {port} answers late: {count} read-backs in a row missed their frame's budget "
                 f"(about {budget_ms:.0f} ms), its status packets came {late_ms:.0f} ms after the request; "
-                "check its Return Delay Time and the adapter's latency timer")
-        else:
-            error, text = ServoTimeout, (
-                f"servo {servo_id} on {port} did not answer {count} read-backs in a row within their frame's budget "
-                f"(about {budget_ms:.0f} ms each); check its power, cable, id and baud rate")
-        if ran_late:
-            unheard_s = self.clock.now() - self.heard_s.get(servo_id, self.started_s)
-            text += (f" (not heard for {unheard_s:.1f} s: the frames ran late and left its reads under "
-                     f"{FAIR_BUDGET_S * 1e3:g} ms, so the computer may be too busy to hear its servos)")
-        return error(text, servo_id=servo_id)
+                "check its Return Delay Time and the adapter's latency timer", servo_id=servo_id)
+        return ServoTimeout(
+            f"servo {servo_id} on {port} did not answer {count} read-backs in a row within their frame's budget "
+            f"(about {budget_ms:.0f} ms each); check its power, cable, id and baud rate", servo_id=servo_id)

@@ -17,7 +17,7 @@ from gaitbot.bus.factory import bus_class
 from gaitbot.bus.dry_run import DryRunPort
 from gaitbot.servos.models import servo_model
 from gaitbot.stream.clock import VirtualClock
-from gaitbot.stream.readback import READ_BACK_MISSES, READ_BACK_SILENCE_S, READ_BACK_UNHEARD_S, ReadBackMonitor
+from gaitbot.stream.readback import READ_BACK_MISSES, READ_BACK_SILENCE_S, ReadBackMonitor
 
 XL430 = servo_model("XL430-W250")
 AX12 = servo_model("AX-12A")
@@ -257,17 +257,17 @@ def test_mixed_misses_are_named_by_what_most_of_them_were(pattern, error, words)
 
 
 def test_misses_in_frames_that_started_late_name_no_one_and_every_servo_is_still_read():
-    """A host late by 14 ms in every frame leaves each read ~1 ms: a servo missing then is not blamed by the
-    silence rule (the host is), and the reading moves on, so a real fault on another servo is still seen.
-    (Until READ_BACK_UNHEARD_S: the next test.)"""
+    """A host late by 14 ms in every frame leaves each read ~1 ms: a servo missing then is not blamed (the
+    host is), and the reading moves on, so a real fault on another servo is still seen."""
     clock = VirtualClock()
     bus = ScriptedBus(clock, {1: "missed", 2: "missed"})
     monitor = ReadBackMonitor(bus, [1, 2, 3, 4, 5, 6], clock, 1 / 60)
-    for k in range(int(READ_BACK_UNHEARD_S * 60) - 6):
+    for k in range(120):
         deadline = k / 60
         clock.sleep_until(deadline + 0.014)  # every frame starts 14 ms late
         monitor(deadline)
     assert set(bus.reads) == {1, 2, 3, 4, 5, 6}
+    assert max(bus.reads.count(i) for i in range(1, 7)) - min(bus.reads.count(i) for i in range(1, 7)) <= 1
 
 
 def test_a_stream_that_stays_late_is_still_read_back():
@@ -291,40 +291,3 @@ def test_a_stream_that_stays_late_is_still_read_back():
     sent = [b for b in bus.budgets if b >= 0.5e-3]
     assert 8 <= len(sent) <= 12  # one read in every six frames
     assert set(bus.reads) == {1, 2, 3}
-
-
-@pytest.mark.parametrize("late_s", [0.012, 0.014, 0.02],
-                         ids=["reads of 2.7 ms", "reads of 0.7 ms: floor reads", "no budget: floor reads"])
-def test_a_silent_servo_on_a_stream_that_stays_late_is_still_stopped_for(late_s):
-    """Every frame late: every read short (12 ms late: 2.7 ms left), too short to count (14 ms: 0.7 ms) or
-    skipped (20 ms), but for a floor read every few frames in the last two. No miss is fair, yet a servo that goes silent is named once it has not been heard for
-    READ_BACK_UNHEARD_S, with READ_BACK_MISSES reads unanswered, the message saying the frames ran late; the
-    same stream with every servo answering runs on. (Before this rule, a CI run whose host kept every frame
-    53 ms late walked the emulator's silent servo to the end of the walk.)"""
-    class Slow(ScriptedBus):
-        """Skips a read under 0.5 ms; a reply takes 1 ms, so a shorter read goes unanswered."""
-        silent_from_s = float("inf")
-
-        def read_back(self, servo_id, budget_s):
-            if budget_s < 0.5e-3:
-                return ReadBack(servo_id, "skipped")
-            result = super().read_back(servo_id, budget_s)
-            silent = servo_id == 3 and self.clock.now() > self.silent_from_s
-            return ReadBack(servo_id, "missed") if silent or budget_s < 1e-3 else result
-
-    class Silent(Slow):
-        silent_from_s = 0.5
-
-    def walk(bus, clock, frames):
-        monitor = ReadBackMonitor(bus, [1, 2, 3, 4, 5, 6], clock, 1 / 60)
-        for k in range(frames):
-            clock.sleep_until(k / 60 + late_s)
-            monitor(k / 60)
-
-    clock = VirtualClock()
-    walk(Slow(clock), clock, 600)  # ten seconds, every servo answering what it can: no stop
-    clock = VirtualClock()
-    bus = Silent(clock)
-    with pytest.raises(ServoTimeout, match=r"servo 3 .*did not answer .*not heard for 1\.\d s: the frames ran late"):
-        walk(bus, clock, 600)
-    assert clock.now() - 0.5 <= READ_BACK_UNHEARD_S + 1.5  # silent from 0.5 s: named within a bound
