@@ -1,13 +1,15 @@
 """The per-frame read-back of a walk session: one servo read after each goal frame, within what is
-left of that frame, never waited on beyond it.
+left of that frame.
 
 After the goals of frame k go out (at its deadline d), one servo is read with a budget that ends at
 ``d + period - READ_BACK_MARGIN_S``, so the read never delays frame k + 1. A read that cannot finish in
 its budget is abandoned for that frame (the bus never retries it inside the frame, and tells a late
 reply to it from the answer to any later read: gaitbot.bus.sdk_bus). Servos are read in turn; a servo
 that missed is read again in the next frames until it answers; ``READ_BACK_MISSES`` misses in a row
-over at least ``READ_BACK_SILENCE_S`` stop the walk naming it (ServoTimeout, ServoLate or CorruptReplies). docs/bus-faults.md has the
-policy and its timing figures.
+over at least ``READ_BACK_SILENCE_S`` stop the walk naming it (ServoTimeout, ServoLate or CorruptReplies).
+Only reads of at least ``FAIR_BUDGET_S`` count; in a stream that stays late, every few frames one read
+gets that long anyway (the one exception to the frame's budget), so a silent servo is still named.
+docs/bus-faults.md has the policy and its timing figures.
 
 Kept general on purpose: :class:`ReadBackMonitor` reads whatever register block the bus's
 ``read_back`` reads, and ``on_answer`` receives every answered :class:`~gaitbot.bus.base.ReadBack`
@@ -29,15 +31,16 @@ READ_BACK_MISSES = 3
 #: does a host too busy to hear its servos for that long: the walk is not under control then either).
 READ_BACK_SILENCE_S = 0.5
 
-#: A miss counts (and makes its servo the one read again) only if its read had at least this long: a frame
-#: that started late leaves its read too little time, and such a miss says more about the host than
-#: the servo (the next servo in turn is read then, so every servo keeps being read).
+#: A miss counts toward the stop only if its read had at least this long: a frame that started late leaves
+#: its read too little time, and such a miss says more about the host than the servo. The servo is still
+#: read again (it is the suspect) until it answers, and a read that follows SHORT_READS_BEFORE_FAIR short
+#: ones gets this long whatever is left of its frame: so a servo that is silent is named even in a stream
+#: that stays late, and a healthy one on a busy host answers that read and is cleared.
 FAIR_BUDGET_S = 4.0e-3
-#: When this many frames in a row started too late to leave their read any budget, the next read gets
-#: READ_BACK_FLOOR_S anyway: a stream that stays late (a very busy host) is still watched, and a servo
-#: reporting error bits still stops it; the cost is at most that much more lateness every few frames.
-SKIPPED_READS_BEFORE_FLOOR = 5
-READ_BACK_FLOOR_S = 2.0e-3
+#: After this many reads in a row with less than FAIR_BUDGET_S (none sent, or too short to be fair), the
+#: next read gets FAIR_BUDGET_S anyway; the cost is at most that much more lateness every few frames of a
+#: stream that is late already.
+SHORT_READS_BEFORE_FAIR = 5
 #: The read-back's budget ends this long before the next frame's deadline: room for the clock's wake-up
 #: (the MonotonicClock spins its last 1.5 ms) so the next goals still go out on time.
 READ_BACK_MARGIN_S = 2.0e-3
@@ -70,7 +73,7 @@ class ReadBackMonitor:
         self.missed: dict[int, list[ReadBack]] = {}  # servo -> its misses in a row
         self.reads = 0
         self.skipped = 0
-        self.skipped_in_row = 0
+        self.short_in_row = 0  # reads in a row with less than a fair budget (skipped or short)
 
     def budget_s(self, deadline_s: float) -> float:
         return deadline_s + self.period_s - self.margin_s - self.clock.now()
@@ -80,17 +83,17 @@ class ReadBackMonitor:
             servo_id = self.suspect
         else:
             servo_id = self.ids[self.next_index % len(self.ids)]
+        fair_s = min(FAIR_BUDGET_S, 0.25 * self.period_s)
         budget_s = self.budget_s(deadline_s)
-        if self.skipped_in_row >= SKIPPED_READS_BEFORE_FLOOR:
-            budget_s = max(budget_s, READ_BACK_FLOOR_S)
+        if self.short_in_row >= SHORT_READS_BEFORE_FAIR:
+            budget_s = max(budget_s, fair_s)
+        self.short_in_row = self.short_in_row + 1 if budget_s < fair_s else 0
         asked_s = self.clock.now()
         result = self.bus.read_back(servo_id, budget_s)
         self.reads += 1
         if result.outcome == "skipped":
             self.skipped += 1
-            self.skipped_in_row += 1
             return
-        self.skipped_in_row = 0
         if result.outcome == "answered":
             self.missed.pop(servo_id, None)
             self.first_miss_s.pop(servo_id, None)
@@ -100,9 +103,8 @@ class ReadBackMonitor:
             if self.on_answer is not None:
                 self.on_answer(result)
             return
-        if budget_s < min(FAIR_BUDGET_S, 0.25 * self.period_s):
-            if self.suspect != servo_id:
-                self.next_index += 1
+        if budget_s < fair_s:  # read again (a fair read comes within a few frames), not yet blamed
+            self.suspect = servo_id
             return
         self.suspect = servo_id
         self.first_miss_s.setdefault(servo_id, asked_s)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 import threading
@@ -344,16 +345,22 @@ def test_a_servo_heating_past_its_limit_stops_the_walk_safely_and_check_reports_
     proc, record, check = walk_on(robot, config_, tmp_path)
     out = proc.stdout + proc.stderr
     assert proc.returncode == 1, out
-    assert f"servo {knee.id} (knee_pitch_left) is at {stop_c} °C, at or above its stop temperature {stop_c} °C" in out
+    # the knee is read about every 0.1 s while it heats 6 °C/s: the first reading at or above the stop is the stop
+    # temperature, or a degree or two more when a busy host's frames came late and its reads were spaced further
+    seen = re.search(rf"servo {knee.id} \(knee_pitch_left\) is at (\d+) °C, at or above its stop temperature "
+                     rf"{stop_c} °C", out)
+    assert seen, out
+    hot_c = int(seen.group(1))
+    assert stop_c <= hot_c <= stop_c + 2, out
     assert "Walk stopped to protect a servo" in out and "ramped to the stand pose" in out and "Traceback" not in out
     decode_goal_frames(record)  # strictly readable
     assert check.returncode == 1
-    assert f"hottest servo: servo {knee.id} (knee_pitch_left) at {stop_c} °C" in check.stdout
-    assert f"servo {knee.id} (knee_pitch_left) at {stop_c} °C, at or above the stop temperature" in check.stdout
+    assert f"hottest servo: servo {knee.id} (knee_pitch_left) at {hot_c} °C" in check.stdout
+    assert f"servo {knee.id} (knee_pitch_left) at {hot_c} °C, at or above the stop temperature" in check.stdout
     as_json = subprocess.run([sys.executable, "-m", "gaitbot.app.cli", "check", str(record), "--json"],
                              capture_output=True, text=True, timeout=TIMEOUT_S, cwd=REPO_ROOT)
     hottest = json.loads(as_json.stdout)["servo_health"]["hottest"]
-    assert (hottest["id"], hottest["temperature_c"]) == (knee.id, stop_c)
+    assert (hottest["id"], hottest["temperature_c"]) == (knee.id, hot_c)
 
 
 @pytest.mark.parametrize("protocol", slow_except(["dxl2", "dxl1", "feetech"]))
