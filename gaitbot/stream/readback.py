@@ -66,6 +66,7 @@ class ReadBackMonitor:
         self.misses = int(misses)
         self.silence_s = float(silence_s)
         self.margin_s = min(float(margin_s), 0.25 * self.period_s)
+        self.fair_s = min(FAIR_BUDGET_S, 0.25 * self.period_s)  # a read this long may blame its servo
         self.first_miss_s: dict[int, float] = {}  # servo -> when the first read of its current run of misses began
         self.on_answer = on_answer
         self.next_index = 0
@@ -83,11 +84,10 @@ class ReadBackMonitor:
             servo_id = self.suspect
         else:
             servo_id = self.ids[self.next_index % len(self.ids)]
-        fair_s = min(FAIR_BUDGET_S, 0.25 * self.period_s)
         budget_s = self.budget_s(deadline_s)
         if self.short_in_row >= SHORT_READS_BEFORE_FAIR:
-            budget_s = max(budget_s, fair_s)
-        self.short_in_row = self.short_in_row + 1 if budget_s < fair_s else 0
+            budget_s = max(budget_s, self.fair_s)
+        self.short_in_row = self.short_in_row + 1 if budget_s < self.fair_s else 0
         asked_s = self.clock.now()
         result = self.bus.read_back(servo_id, budget_s)
         self.reads += 1
@@ -103,10 +103,9 @@ class ReadBackMonitor:
             if self.on_answer is not None:
                 self.on_answer(result)
             return
-        if budget_s < fair_s:  # read again (a fair read comes within a few frames), not yet blamed
-            self.suspect = servo_id
+        self.suspect = servo_id  # read again until it answers
+        if budget_s < self.fair_s:  # too short to blame it: a fair read comes within a few frames
             return
-        self.suspect = servo_id
         self.first_miss_s.setdefault(servo_id, asked_s)
         misses = self.missed.setdefault(servo_id, [])
         misses.append(result)

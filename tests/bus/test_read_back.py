@@ -278,8 +278,8 @@ class ShortReadsMiss(ScriptedBus):
 
 
 def run_late(bus: ShortReadsMiss, late_s: float, frames: int) -> float:
-    """Six servos; every frame starts ``late_s`` after its deadline. Returns the time the monitor raised
-    (or ran out of frames)."""
+    """Six servos; every frame starts ``late_s`` after its deadline. Returns the clock's time after the last
+    frame (a stop raises before it: the clock then says when)."""
     clock = bus.clock
     monitor = ReadBackMonitor(bus, [1, 2, 3, 4, 5, 6], clock, 1 / 60)
     for k in range(frames):
