@@ -7,11 +7,12 @@
     python tools/push_survival.py --markdown         # docs/feedback.md's figure: survived per quarter of the range
     python tools/push_survival.py --modes step       # capture-point stepping (--feedback step)
     python tools/push_survival.py --modes full,zmp   # the CoM error fed to the preview controller (--feedback zmp)
+    python tools/push_survival.py --walk="--distance 1"   # another walk of the robot (here its default speed)
 
 Each push is drawn from a seeded generator (--seed): an impulse uniform in 0..--max-impulse N s, a direction
 uniform in 0..360 deg (from forward, counter-clockwise), a phase uniform over the middle step (its share of
 the way from the start of that step's swing window to the next one's: ``--push-phase``). The walk: ``gaitbot
-walk --sim`` of WALKS (op3: 1 m at 0.15 m/s, cycle 0.8 s, steps of 6 cm), through the whole session and the
+walk --sim`` of WALKS (op3: 1 m at 0.15 m/s, cycle 0.8 s, steps of 6 cm) or of ``--walk``'s arguments, through the whole session and the
 simulated bus, the IMU seeded by the push's number (``--imu-seed N``), so that push N is rerun alone by
 
     gaitbot walk --sim --robot op3 --distance 1 --cycle 0.8 --max-step 0.06 --feedback full --imu-seed N \\
@@ -20,7 +21,8 @@ simulated bus, the IMU seeded by the push's number (``--imu-seed N``), so that p
 with its row's numbers as --json prints them (the walk is given the same digits). The IMU's figures are the
 robot config's ([imu]: op3 0.5 deg/s noise, 1 deg/s bias, one frame). A push survived: no fall
 (gaitbot.sim.metrics) to the end of the walk. Prints a table of every push and the share survived per
-feedback mode. Exit 1 if a walk failed to run.
+feedback mode. A walk that fails to run stops it with one line: exit 2 when the walk refused its arguments
+(``--walk``), else 1.
 """
 
 from __future__ import annotations
@@ -36,6 +38,14 @@ import numpy as np
 from gaitbot.app.cli import main
 
 WALKS = {"op3": "--distance 1 --cycle 0.8 --max-step 0.06", "bioloid": "--distance 0.8 --cycle 0.8 --max-step 0.04"}
+
+
+class WalkFailed(RuntimeError):
+    """A walk that did not run (``gaitbot walk``'s exit status and its last line of error)."""
+
+    def __init__(self, code: int, line: str) -> None:
+        self.code = code
+        super().__init__(f"walk failed (exit {code}): {line}")
 
 
 def drawn_pushes(pushes: int, seed: int, max_impulse: float) -> list[tuple[float, float, float]]:
@@ -54,7 +64,7 @@ def one_push(robot: str, walk: str, impulse: float, direction: float, phase: flo
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         code = main(args)
     if code not in (0, 1):
-        raise RuntimeError(f"walk failed (exit {code}): {err.getvalue().strip()}")
+        raise WalkFailed(code, err.getvalue().strip().splitlines()[-1] if err.getvalue().strip() else "")
     report = json.loads(out.getvalue())
     return {"impulse_n_s": round(impulse, 3), "direction_deg": round(direction, 1), "phase": round(phase, 6),
             "feedback": feedback, "survived": not report["fell"], "fell_at_s": report["fell_at_s"],
@@ -82,7 +92,7 @@ def markdown(args) -> str:
         quarter = min(int(impulse / args.max_impulse * 4), 3)
         counts[quarter, 0] += 1
         for i, m in enumerate(modes):
-            row = one_push(args.robot, WALKS[args.robot], impulse, direction, phase, n, m)
+            row = one_push(args.robot, args.walk, impulse, direction, phase, n, m)
             survived[m].append(row["survived"])
             counts[quarter, 1 + i] += row["survived"]
             if row["noticed_after_s"] is not None:
@@ -93,7 +103,8 @@ def markdown(args) -> str:
         rows.append(f"| {edges[q]:g} to {edges[q + 1]:g} | {counts[q, 0]} | "
                     + " | ".join(str(c) for c in counts[q, 1:]) + " |")
     rows.append(f"| all | {counts[:, 0].sum()} | " + " | ".join(str(c) for c in counts[:, 1:].sum(axis=0)) + " |")
-    name = f"push-{args.robot}" + "".join(f"-{m}" for m in ("step", "zmp") if m in modes)
+    name = (f"push-{args.robot}" + "".join(f"-{m}" for m in ("step", "zmp") if m in modes)
+            + ("-walk" if args.walk != WALKS[args.robot] else ""))
     return (f"<!-- figure {name} -->\n" + "\n".join(rows) + "\n<!-- /figure -->\n"
             f"<!-- figure {name}-by-way -->\n" + by_way(draws, survived, modes) + "\n<!-- /figure -->\n"
             f"<!-- figure {name}-noticed -->\n" + noticed_lines(noticed) + "\n<!-- /figure -->")
@@ -131,7 +142,19 @@ def main_(argv=None) -> int:
     parser.add_argument("--modes", default="none,full", help="feedback modes, comma-separated: none, gyro, full, step, zmp")
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--markdown", action="store_true", help="print the docs' figure (tools/figures.py)")
+    parser.add_argument("--walk", help="gaitbot walk's arguments for the walk pushed, one string (default: WALKS of "
+                        "the robot; a figure of another walk is named push-ROBOT...-walk)")
     args = parser.parse_args(argv)
+    args.walk = args.walk if args.walk is not None else WALKS[args.robot]
+    try:
+        return run(args)
+    except WalkFailed as failed:
+        print(f"push_survival.py: --walk {args.walk!r}: {failed}", file=sys.stderr)
+        return 2 if failed.code == 2 else 1
+
+
+def run(args) -> int:
+    """The table (or the docs' figure) of args' pushes."""
     if args.markdown:
         print(markdown(args))
         return 0
@@ -143,7 +166,7 @@ def main_(argv=None) -> int:
         print("| push | impulse N s | direction deg | phase | " + " | ".join(f"survived ({m})" for m in modes) + " |")
         print("|---|---|---|---|" + "---|" * len(modes))
     for n, (impulse, direction, phase) in enumerate(draws, start=1):
-        rows = [one_push(args.robot, WALKS[args.robot], impulse, direction, phase, n, m) for m in modes]
+        rows = [one_push(args.robot, args.walk, impulse, direction, phase, n, m) for m in modes]
         for row in rows:
             survived[row["feedback"]] += row["survived"]
             if row["noticed_after_s"] is not None:
@@ -154,7 +177,7 @@ def main_(argv=None) -> int:
             cells = " | ".join("yes" if r["survived"] else f"no ({r['fall_direction']})" for r in rows)
             print(f"| {n} | {impulse:.2f} | {direction:.0f} | {phase:.2f} | {cells} |", flush=True)
     if not args.json:
-        print(f"\n{args.robot}, {args.pushes} pushes of 0..{args.max_impulse:g} N s (seed {args.seed}): "
+        print(f"\n{args.robot} walking {args.walk}, {args.pushes} pushes of 0..{args.max_impulse:g} N s (seed {args.seed}): "
               + "; ".join(f"feedback {m}: {survived[m]} survived" for m in modes))
         print(noticed_lines(noticed))
     return 0
