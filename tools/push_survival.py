@@ -12,8 +12,9 @@
 Each push is drawn from a seeded generator (--seed): an impulse uniform in 0..--max-impulse N s, a direction
 uniform in 0..360 deg (from forward, counter-clockwise), a phase uniform over the middle step (its share of
 the way from the start of that step's swing window to the next one's: ``--push-phase``). The walk: ``gaitbot
-walk --sim`` of WALKS (op3: 1 m at 0.15 m/s, cycle 0.8 s, steps of 6 cm) or of ``--walk``'s arguments, through the whole session and the
-simulated bus, the IMU seeded by the push's number (``--imu-seed N``), so that push N is rerun alone by
+walk --sim`` of WALKS (op3: 1 m at 0.15 m/s, cycle 0.8 s, steps of 6 cm) or of ``--walk``'s arguments,
+through the whole session and the simulated bus, the IMU seeded by the push's number (``--imu-seed N``), so
+that push N is rerun alone by
 
     gaitbot walk --sim --robot op3 --distance 1 --cycle 0.8 --max-step 0.06 --feedback full --imu-seed N \\
         --push IMPULSE@DIRECTION --push-phase PHASE
@@ -177,7 +178,8 @@ def run(args) -> int:
             cells = " | ".join("yes" if r["survived"] else f"no ({r['fall_direction']})" for r in rows)
             print(f"| {n} | {impulse:.2f} | {direction:.0f} | {phase:.2f} | {cells} |", flush=True)
     if not args.json:
-        print(f"\n{args.robot} walking {args.walk}, {args.pushes} pushes of 0..{args.max_impulse:g} N s (seed {args.seed}): "
+        print(f"\n{args.robot} walking {args.walk}, {args.pushes} pushes of 0..{args.max_impulse:g} N s "
+              f"(seed {args.seed}): "
               + "; ".join(f"feedback {m}: {survived[m]} survived" for m in modes))
         print(noticed_lines(noticed))
     return 0
