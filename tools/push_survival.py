@@ -23,7 +23,7 @@ with its row's numbers as --json prints them (the walk is given the same digits)
 robot config's ([imu]: op3 0.5 deg/s noise, 1 deg/s bias, one frame). A push survived: no fall
 (gaitbot.sim.metrics) to the end of the walk. Prints a table of every push and the share survived per
 feedback mode. A walk that fails to run stops it with one line: exit 2 when the walk refused its arguments
-(``--walk``), else 1.
+(``--walk``, or an option of OWN_OPTIONS in it), else 1.
 """
 
 from __future__ import annotations
@@ -39,6 +39,9 @@ import numpy as np
 from gaitbot.app.cli import main
 
 WALKS = {"op3": "--distance 1 --cycle 0.8 --max-step 0.06", "bioloid": "--distance 0.8 --cycle 0.8 --max-step 0.04"}
+OWN_OPTIONS = ("--sim", "--json", "--robot", "--feedback", "--imu-seed", "--push", "--push-phase")
+"""gaitbot walk's options this tool sets for every push: refused inside --walk (they would be overridden, or
+would walk another robot than the one the table names)."""
 
 
 class WalkFailed(RuntimeError):
@@ -63,7 +66,10 @@ def one_push(robot: str, walk: str, impulse: float, direction: float, phase: flo
     if impulse > 0:
         args += ["--push", f"{impulse:.3f}@{direction:.1f}", "--push-phase", f"{phase:.6f}"]
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = main(args)
+        try:
+            code = main(args)
+        except SystemExit as refused:  # argparse's refusal of a malformed argument: its line is in err
+            code = refused.code
     if code not in (0, 1):
         raise WalkFailed(code, err.getvalue().strip().splitlines()[-1] if err.getvalue().strip() else "")
     report = json.loads(out.getvalue())
@@ -147,6 +153,11 @@ def main_(argv=None) -> int:
                         "the robot; a figure of another walk is named push-ROBOT...-walk)")
     args = parser.parse_args(argv)
     args.walk = args.walk if args.walk is not None else WALKS[args.robot]
+    own = [word.split("=")[0] for word in args.walk.split() if word.split("=")[0] in OWN_OPTIONS]
+    if own:
+        print(f"push_survival.py: --walk {args.walk!r}: {own[0]} is set by this tool for every push (the robot: "
+              f"--robot; the feedback: --modes)", file=sys.stderr)
+        return 2
     try:
         return run(args)
     except WalkFailed as failed:

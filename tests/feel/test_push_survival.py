@@ -7,6 +7,8 @@ import re
 import sys
 from pathlib import Path
 
+import pytest
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
 import push_survival  # noqa: E402
 
@@ -26,11 +28,18 @@ def test_another_walk_has_its_own_figure_names(capsys):
                                                               "push-op3-walk-noticed"]
 
 
-def test_a_walk_that_refuses_its_arguments_stops_with_one_line_and_exit_2(capsys):
-    code = push_survival.main_(["--walk=--distance 1 --cycle 0.1", "--pushes", "1", "--modes", "full"])
+@pytest.mark.parametrize("walk, reason", [
+    ("--distance 1 --cycle 0.1", "--cycle must be"),  # gaitbot walk's own check
+    ("--distance abc", "invalid float value: 'abc'"),  # its argument parser's
+    ("--bogus", "unrecognized arguments: --bogus"),
+    ("--distance 1 --robot bioloid", "--robot is set by this tool"),  # the table would name another robot
+    ("--feedback=none", "--feedback is set by this tool"),  # the tool's --modes would override it
+])
+def test_a_walk_that_refuses_its_arguments_stops_with_one_line_and_exit_2(walk, reason, capsys):
+    code = push_survival.main_([f"--walk={walk}", "--pushes", "1", "--modes", "full"])
     err = capsys.readouterr().err
     assert code == 2
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in err
-    assert lines[0].startswith("push_survival.py: --walk '--distance 1 --cycle 0.1'")
-    assert "--cycle must be" in lines[0]  # gaitbot walk's own reason, passed on
+    assert lines[0].startswith(f"push_survival.py: --walk {walk!r}")
+    assert reason in lines[0]  # the reason, passed on
