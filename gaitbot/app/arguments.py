@@ -52,7 +52,8 @@ def walk_options(p: argparse.ArgumentParser, demo: bool = False) -> None:
     leg_options(p)
     p.add_argument("--clearance", type=float, metavar="M",
                    help="how high the whole swing sole stays above the ground while the foot moves forward, "
-                   "metres (default: the robot's clearance_m)")
+                   "metres (default: the robot's clearance_m, which a balanced walk's speed fit may lower; "
+                   "one given here is kept)")
     p.add_argument("--rate", type=float, metavar="HZ", help="frame rate in Hz (default: the robot's rate_hz)")
     p.add_argument("--cycle", type=float, metavar="S", help="walking cycle (two steps) in seconds "
                    "(default: the robot's cycle_s)")

@@ -17,7 +17,7 @@ from pathlib import Path
 from gaitbot.app.arguments import add_command, check_walk_source, walk_options
 from gaitbot.app.options import UsageError, walked_by
 from gaitbot.app.outputs import output_path, write_output
-from gaitbot.app.planned_walk import planned_walk
+from gaitbot.app.planned_walk import clearance_hint, planned_walk
 from gaitbot.check.preflight import LimitBroken, preflight
 from gaitbot.gait.terrain.course_file import load_course
 from gaitbot.gait.trajectory import load_fast
@@ -69,4 +69,5 @@ def refuse_what_walk_refuses(walk, written, goals: bool = False) -> None:
                preflight(config, walk.goals, planned=walk.planned))
     for report in reports:
         if not report.ok:
-            raise LimitBroken(f"wrote {written}, but gaitbot walk would refuse it: {report.first_error}")
+            raise LimitBroken(f"wrote {written}, but gaitbot walk would refuse it: {report.first_error}"
+                              f"{clearance_hint(walk.source)}")

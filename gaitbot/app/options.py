@@ -113,9 +113,11 @@ def gait_source(args, robot: RobotConfig | None = None) -> GaitSource:
         settings = WalkSettings(settings.cycle_s, settings.rate_hz, clearance)
     reachable = longest_step_m(geometry, settings)
     max_step = robot.gait.max_step_m if robot_for_limits is not None else reachable
+    asked = clearance is not None
     if robot_for_limits is not None and robot.is_3d:  # its max_step_m is the default; the leg's reach the limit
-        return GaitSource(geometry, settings, reachable, robot, default_step_m=min(max_step, reachable))
-    return GaitSource(geometry, settings, min(max_step, reachable), robot_for_limits)
+        return GaitSource(geometry, settings, reachable, robot, default_step_m=min(max_step, reachable),
+                          clearance_asked=asked)
+    return GaitSource(geometry, settings, min(max_step, reachable), robot_for_limits, clearance_asked=asked)
 
 
 #: The most steps one walk may have (planning costs about 5 ms a step), and the longest --distance.

@@ -240,7 +240,8 @@ def balanced_plan(source: GaitSource, steps, max_step_m: float | None = None) ->
     step asked for (``gaitbot eigen synth`` starts and stops its walks with the same walks)."""
     longest = max([max_step_m or source.default_step_m or 0.0, *steps])
     gait = balanced_gait_settings(source.robot, cycle_s=source.settings.cycle_s, rate_hz=source.settings.rate_hz,
-                                  max_step_m=longest, clearance_m=source.settings.clearance)
+                                  max_step_m=longest, clearance_m=source.settings.clearance,
+                                  clearance_asked=source.clearance_asked)
     return plan_balanced(source.robot, steps, gait)
 
 
@@ -252,7 +253,8 @@ def speed_fit_note(plan: BalancedPlan) -> str | None:
         return None
     b, g = fit.balance, fit.gait
     settings = (f"crouch {b.crouch_knee_deg:g} deg, double support {100 * b.double_support_share:g}%, progression "
-                f"done at {100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm")
+                f"done at {100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm"
+                + (" (as --clearance asked: kept, not lowered)" if g.clearance_asked else ""))
     peak = f"peak {fit.peak_dps:.0f} deg/s, {100 * fit.peak_share:.1f}% of a limit"
     # a foot still travelling when it lands lands short (measured: docs/walk-faster.md)
     short = ("; with the foot moving until it lands, steps land short of the plan: a longer --cycle with longer "
@@ -263,6 +265,15 @@ def speed_fit_note(plan: BalancedPlan) -> str | None:
                 f"{settings} ({peak}; a longer --cycle or shorter steps fit; docs/checking.md){short}")
     return (f"the servos' limits (max_velocity_dps {fit.limit_dps:g}, kept within {100 * fit.target_share:g}%) needed "
             f"a gentler walk at this cycle and step: {settings} ({peak}; docs/balance.md){short}")
+
+
+def clearance_hint(source: GaitSource) -> str:
+    """Said with a balanced walk's limit refusal when ``--clearance`` was given: the speed fit kept it, where it
+    lowers the robot's own clearance to fit the servos (gaitbot.gait.balance.speed_fit)."""
+    if not (source.balanced and source.clearance_asked):
+        return ""
+    return (f" (--clearance {source.settings.clearance:g} m is kept as asked, not lowered to fit the servos: a "
+            f"lower one, a longer --cycle or shorter steps may fit)")
 
 
 def terrain_walk(source: GaitSource, course_path: str, clearance_m: float | None = None):

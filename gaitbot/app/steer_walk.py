@@ -67,7 +67,7 @@ def steered_plan(source, args) -> "SteeredPlan":
         schedule = schedule_of(args)
         gait = balanced_gait_settings(source.robot, cycle_s=source.settings.cycle_s, rate_hz=source.settings.rate_hz,
                                       max_step_m=getattr(args, "max_step", None) or source.default_step_m,
-                                      clearance_m=source.settings.clearance)
+                                      clearance_m=source.settings.clearance, clearance_asked=source.clearance_asked)
         plan, steps = plan_steered(source.robot, schedule, gait, MAX_STEPS)
     except CommandError as exc:
         raise UsageError(str(exc)) from None

@@ -16,7 +16,7 @@ from gaitbot.app.feel_options import (add_feedback_option, fall_dict, fall_line,
 from gaitbot.app.hardware import refuse_port_in_dry_run, serial_port, warn_about_latency
 from gaitbot.app.file_robot import robot_for_walk
 from gaitbot.app.options import UsageError, check_rate_option, check_reply_timeout, file_option
-from gaitbot.app.planned_walk import PlannedWalk, planned_walk
+from gaitbot.app.planned_walk import PlannedWalk, clearance_hint, planned_walk
 from gaitbot.app.outputs import output_path
 from gaitbot.app.progress import callback, progress
 from gaitbot.app.sim_options import (add_push_phase_option, add_sim_model_options, check_push_phase,
@@ -103,7 +103,7 @@ def run(args) -> int:
     check_stepping(args, config, walk)
     report = preflight(config, walk.goals, on_boom=args.boom, planned=walk.planned)
     if not report.ok:
-        raise LimitBroken(f"walk refused before anything moved: {report.first_error}")
+        raise LimitBroken(f"walk refused before anything moved: {report.first_error}{clearance_hint(walk.source)}")
     frames = trajectory_ticks(config, walk.goals)
     straight = [name for name in config.walking_joint_names if name not in walk.goals.joints]
     if straight:

@@ -26,12 +26,14 @@ from gaitbot.robot.motion_margin import PLANNED_SHARE
 
 
 def balanced_gait_settings(config: RobotConfig, *, cycle_s: float | None = None, rate_hz: float | None = None,
-                           max_step_m: float | None = None, clearance_m: float | None = None) -> BalancedGaitSettings:
-    """``[gait]`` with the command line's overrides."""
+                           max_step_m: float | None = None, clearance_m: float | None = None,
+                           clearance_asked: bool = False) -> BalancedGaitSettings:
+    """``[gait]`` with the command line's overrides (``clearance_asked``: ``clearance_m`` is the user's, kept)."""
     g = config.gait
     return BalancedGaitSettings(cycle_s=cycle_s or g.cycle_s, rate_hz=rate_hz or g.rate_hz,
                                 max_step_m=max_step_m or g.max_step_m,
-                                clearance_m=g.clearance_m if clearance_m is None else clearance_m)
+                                clearance_m=g.clearance_m if clearance_m is None else clearance_m,
+                                clearance_asked=clearance_asked)
 
 
 def _leg_joint(config: RobotConfig, name: str):

@@ -35,13 +35,15 @@ class GaitSource:
     ``robot`` is None when the leg is not the configured robot's (a leg given on the command line),
     whose joint limits then do not apply. ``default_step_m``: the longest step of ``--distance`` when
     ``--max-step`` is not given, if not ``max_step_m`` (a balanced robot's ``[gait] max_step_m`` is its
-    default, and its reach the limit)."""
+    default, and its reach the limit). ``clearance_asked``: the settings' clearance is ``--clearance``'s, which a
+    balanced walk keeps (its speed fit lowers only the robot's own)."""
 
     geometry: LegGeometry
     settings: WalkSettings
     max_step_m: float
     robot: RobotConfig | None
     default_step_m: float | None = None
+    clearance_asked: bool = False
 
     @property
     def balanced(self) -> bool:

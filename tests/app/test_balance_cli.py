@@ -48,6 +48,21 @@ def test_the_speed_fits_note_says_when_its_steps_will_land_short(args, short, ca
     assert ("steps land short" in notes[0]) == short
 
 
+def test_an_asked_clearance_is_walked_as_asked_or_refused_naming_it(capsys):
+    """The 0.15 m/s walk needs the speed fit's fallbacks, which lower the op3's own 5 mm clearance to 3 mm; a
+    clearance given with --clearance is kept (and the note says so), and one the servos cannot follow is
+    refused before anything moves with the refusal naming it, not quietly lowered."""
+    fast = ("--robot", "op3", "--distance", "1", "--cycle", "0.8", "--max-step", "0.06")
+    assert plan_json(capsys, *fast)["clearance_m"] == pytest.approx(0.003)
+    code, out, err = run_cli(capsys, "plan", "--json", *fast, "--clearance", "0.005")
+    assert code == 0 and json.loads(out)["clearance_m"] == pytest.approx(0.005)
+    assert "clearance 5 mm (as --clearance asked: kept, not lowered)" in err
+    code, _, err = run_cli(capsys, "walk", "--dry-run", *fast, "--clearance", "0.008")
+    errors = [line for line in err.splitlines() if not line.startswith("note: ")]
+    assert code == 1 and len(errors) == 1 and "walk refused before anything moved: knee_pitch" in errors[0]
+    assert "--clearance 0.008 m is kept as asked" in errors[0]
+
+
 def test_generate_goals_add_the_sag_feedforward_on_a_balanced_robot_only(capsys, tmp_path):
     for robot, differ in (("op3", True), ("xl430-biped", False)):
         planned, goals = tmp_path / f"{robot}.csv", tmp_path / f"{robot}-goals.csv"

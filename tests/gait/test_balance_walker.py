@@ -219,6 +219,17 @@ def test_the_speed_fit_leaves_the_foot_moving_until_it_lands_for_last():
         assert later.peak_share >= fit.peak_share
 
 
+def test_the_speed_fit_lowers_the_robots_own_clearance_and_never_an_asked_one():
+    """The fallbacks lower the robot's clearance (op3: 5 mm) to 3 mm; a clearance the user asked for
+    (``--clearance``) is the user's: every candidate keeps it, and only the rest is relaxed."""
+    own = candidates(balanced_gait_settings(OP3, cycle_s=0.8, max_step_m=0.06), OP3.balance)
+    assert OP3.gait.clearance_m > 0.003 and {g.clearance_m for _, g in own} == {OP3.gait.clearance_m, 0.003}
+    asked = candidates(balanced_gait_settings(OP3, cycle_s=0.8, max_step_m=0.06, clearance_m=0.008,
+                                              clearance_asked=True), OP3.balance)
+    assert {g.clearance_m for _, g in asked} == {0.008}
+    assert [b for b, _ in asked] == [b for b, _ in own]  # the other relaxations are the same
+
+
 def test_generate_without_feedforward_sends_the_planned_angles():
     gait = balanced_gait_settings(OP3)
     walk = generate_balanced_walk(OP3.body, [0.05, 0.05], gait, OP3.balance)

@@ -8,7 +8,8 @@ and step (on the OP3 a 15% double support, the progression done at 80% of the sw
 1 / ((1 - double support) x progression_end) and its lift with the clearance, so the candidates are, in
 order: the robot's values; the same 10 deg deeper in the crouch (the bent knee lifts and swings the foot
 with less speed); double support 10% / progression 0.9; 5% / 0.9 / clearance 3 mm, then 10 deg deeper;
-5% / 1.0 / 3 mm, then 10 deg deeper (FALLBACKS). The first whose walk keeps every joint at or under ``share``
+5% / 1.0 / 3 mm, then 10 deg deeper (FALLBACKS); a clearance the user asked for is kept (the fallbacks then
+relax the rest only). The first whose walk keeps every joint at or under ``share``
 of its limits (the robot's planners keep PLANNED_SHARE, gaitbot.robot.motion_margin, measured by
 gaitbot.robot.joint_motion: velocity and acceleration of the goal ticks as sent) is used; if none does, the
 one that asks the least share of a limit, the earlier of equals (the limit check then says whether it is
@@ -68,8 +69,8 @@ def candidates(gait: BalancedGaitSettings, balance: BalanceSettings):
         relaxed = replace(balance, double_support_share=min(balance.double_support_share, ds),
                           progression_end=max(balance.progression_end, progression_end),
                           crouch_knee_deg=balance.crouch_knee_deg + deeper_deg)
-        out.append((relaxed, gait if clearance is None else replace(gait, clearance_m=min(gait.clearance_m,
-                                                                                          clearance))))
+        lowered = clearance is not None and not gait.clearance_asked
+        out.append((relaxed, replace(gait, clearance_m=min(gait.clearance_m, clearance)) if lowered else gait))
     return out
 
 

@@ -72,12 +72,15 @@ class BalancedWalkError(GaitGenerationError):
 @dataclass(frozen=True)
 class BalancedGaitSettings:
     """The walk's timing and reach: cycle (s, two steps; rounded to whole frames per step), frame rate
-    (Hz), longest step (m) and the swing sole's least height over the middle of each swing (m)."""
+    (Hz), longest step (m) and the swing sole's least height over the middle of each swing (m).
+    ``clearance_asked``: the clearance is the user's (``--clearance``), which the speed fit keeps rather than
+    lowers (gaitbot.gait.balance.speed_fit)."""
 
     cycle_s: float
     rate_hz: float
     max_step_m: float
     clearance_m: float
+    clearance_asked: bool = False
 
 
 @dataclass(frozen=True)
