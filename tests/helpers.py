@@ -60,15 +60,17 @@ def gaitbot(*args: str, timeout: float = WALK_TIMEOUT_S) -> subprocess.Completed
                           timeout=timeout, stdin=subprocess.DEVNULL, cwd=REPO_ROOT)
 
 
-def emulator_for(config_path: Path, log_path: Path, faults=None, model_numbers=None):
+def emulator_for(config_path: Path, log_path: Path, faults=None, model_numbers=None, imu=None):
     """The servo emulator (gaitbot.emulator) of a robot config on a pty, logging the goals it receives;
-    ``model_numbers`` (servo id -> number): servos that report another model number than their model's."""
+    ``model_numbers`` (servo id -> number): servos that report another model number than their model's;
+    ``imu``: an IMU device on the line (gaitbot.bus.imu_device.ImuDevice)."""
     import gaitbot.emulator as se
 
     robot = load_robot_config(config_path)
     return se.ServoEmulator(se.EmulatorConfig(
         robot.bus.backend, robot.bus.protocol, robot.models_by_id, robot.bus.baudrate, faults or se.Faults(),
-        str(log_path), robot.name, {j.name: j.id for j in robot.joints}, model_numbers=dict(model_numbers or {})))
+        str(log_path), robot.name, {j.name: j.id for j in robot.joints}, model_numbers=dict(model_numbers or {}),
+        imu=imu))
 
 
 # --- recordings

@@ -75,7 +75,8 @@ def one_push(robot: str, walk: str, impulse: float, direction: float, phase: flo
     report = json.loads(out.getvalue())
     return {"impulse_n_s": round(impulse, 3), "direction_deg": round(direction, 1), "phase": round(phase, 6),
             "feedback": feedback, "survived": not report["fell"], "fell_at_s": report["fell_at_s"],
-            "fall_direction": report["fall_direction"], "noticed_after_s": noticed_after_s(report)}
+            "fall_direction": report["fall_direction"], "noticed_after_s": noticed_after_s(report),
+            "least_load_g": report.get("imu_least_load_g")}
 
 
 def noticed_after_s(report: dict) -> float | None:
@@ -95,6 +96,7 @@ def markdown(args) -> str:
     counts = np.zeros((4, 1 + len(modes)), dtype=int)
     survived = {m: [] for m in modes}
     noticed = {m: [] for m in modes}
+    least = {m: [] for m in modes}
     for n, (impulse, direction, phase) in enumerate(draws, start=1):
         quarter = min(int(impulse / args.max_impulse * 4), 3)
         counts[quarter, 0] += 1
@@ -104,6 +106,8 @@ def markdown(args) -> str:
             counts[quarter, 1 + i] += row["survived"]
             if row["noticed_after_s"] is not None:
                 noticed[m].append(row["noticed_after_s"])
+            if row["survived"] and row["least_load_g"] is not None:
+                least[m].append(row["least_load_g"])
     rows = ["| impulse N s | pushes | " + " | ".join(f"survived, feedback {m}" for m in modes) + " |",
             "|---|---|" + "---|" * len(modes)]
     for q in range(4):
@@ -114,13 +118,17 @@ def markdown(args) -> str:
             + ("-walk" if args.walk != WALKS[args.robot] else ""))
     return (f"<!-- figure {name} -->\n" + "\n".join(rows) + "\n<!-- /figure -->\n"
             f"<!-- figure {name}-by-way -->\n" + by_way(draws, survived, modes) + "\n<!-- /figure -->\n"
-            f"<!-- figure {name}-noticed -->\n" + noticed_lines(noticed) + "\n<!-- /figure -->")
+            f"<!-- figure {name}-noticed -->\n" + noticed_lines(noticed, least) + "\n<!-- /figure -->")
 
 
-def noticed_lines(noticed: dict) -> str:
-    """How long after the true tilt crossed the fall threshold the IMU noticed each fall, per mode."""
-    return "\n".join(f"feedback {m}: {len(v)} falls noticed by the IMU, {min(v) * 1e3:.0f} to {max(v) * 1e3:.0f} ms "
-                     f"after the true tilt crossed the threshold" for m, v in noticed.items() if v)
+def noticed_lines(noticed: dict, least: dict) -> str:
+    """How long after the true tilt crossed the fall threshold the IMU noticed each fall, per mode; and how close
+    the walks that stood came to the load-lost test (their lowest accelerometer magnitude held over its window)."""
+    lines = [f"feedback {m}: {len(v)} falls noticed by the IMU, {min(v) * 1e3:.0f} to {max(v) * 1e3:.0f} ms "
+             f"after the true tilt crossed the threshold" for m, v in noticed.items() if v]
+    lines += [f"feedback {m}: the {len(v)} walks that stood held the accelerometer at {min(v):.2f} g or more over "
+              f"every load-lost window" for m, v in least.items() if v]
+    return "\n".join(lines)
 
 
 WAYS = ("forwards", "to the left", "backwards", "to the right")
@@ -174,6 +182,7 @@ def run(args) -> int:
     modes = args.modes.split(",")
     survived = {m: 0 for m in modes}
     noticed = {m: [] for m in modes}
+    least = {m: [] for m in modes}
     if not args.json:
         print("| push | impulse N s | direction deg | phase | " + " | ".join(f"survived ({m})" for m in modes) + " |")
         print("|---|---|---|---|" + "---|" * len(modes))
@@ -183,6 +192,8 @@ def run(args) -> int:
             survived[row["feedback"]] += row["survived"]
             if row["noticed_after_s"] is not None:
                 noticed[row["feedback"]].append(row["noticed_after_s"])
+            if row["survived"] and row["least_load_g"] is not None:
+                least[row["feedback"]].append(row["least_load_g"])
             if args.json:
                 print(json.dumps(row))
         if not args.json:
@@ -192,7 +203,7 @@ def run(args) -> int:
         print(f"\n{args.robot} walking {args.walk}, {args.pushes} pushes of 0..{args.max_impulse:g} N s "
               f"(seed {args.seed}): "
               + "; ".join(f"feedback {m}: {survived[m]} survived" for m in modes))
-        print(noticed_lines(noticed))
+        print(noticed_lines(noticed, least))
     return 0
 
 

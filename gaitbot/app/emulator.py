@@ -124,8 +124,8 @@ def hand_from_trajectory(robot, path: str, rate_hz: float | None = None) -> Hand
 def imu_from_args(args: argparse.Namespace, config: EmulatorConfig) -> ImuDevice | None:
     """The IMU device of ``--imu`` (its fall and fault), or None; ValueError naming the argument."""
     if not args.imu:
-        if args.imu_fall_at_s is not None or args.imu_fault:
-            raise ValueError("--imu-fall-at-s and --imu-fault need --imu (an IMU on the line)")
+        if args.imu_fall_at_s is not None or args.imu_drop_at_s is not None or args.imu_fault:
+            raise ValueError("--imu-fall-at-s, --imu-drop-at-s and --imu-fault need --imu (an IMU on the line)")
         return None
     if config.protocol != 2.0:
         raise ValueError("--imu: the OpenCR answers Dynamixel Protocol 2.0 only (this chain speaks "
@@ -136,9 +136,10 @@ def imu_from_args(args: argparse.Namespace, config: EmulatorConfig) -> ImuDevice
         device_id = imu.device_id if imu.source == "opencr" else OPENCR_OP3_ID
     if device_id in config.models:
         raise ValueError(f"--imu: id {device_id} is a servo's on this chain")
-    fall = args.imu_fall_at_s
-    if fall is not None and not (math.isfinite(fall) and 0 <= fall <= 86_400):
-        raise ValueError(f"--imu-fall-at-s must be within 0..86400 s, got {fall}")
+    fall, drop = args.imu_fall_at_s, args.imu_drop_at_s
+    for name, value in (("--imu-fall-at-s", fall), ("--imu-drop-at-s", drop)):
+        if value is not None and not (math.isfinite(value) and 0 <= value <= 86_400):
+            raise ValueError(f"{name} must be within 0..86400 s, got {value}")
     fault, at_s = None, 1.0
     if args.imu_fault:
         fault, _, when = args.imu_fault.partition("@")
@@ -150,7 +151,7 @@ def imu_from_args(args: argparse.Namespace, config: EmulatorConfig) -> ImuDevice
             raise ValueError(f"--imu-fault {args.imu_fault!r}: S must be a number of seconds") from None
         if not (math.isfinite(at_s) and 0 <= at_s <= 86_400):
             raise ValueError(f"--imu-fault {args.imu_fault!r}: S must be within 0..86400 s")
-    return ImuDevice(device_id=device_id, fall_at_s=fall, fault=fault, fault_at_s=at_s, seed=args.seed)
+    return ImuDevice(device_id=device_id, fall_at_s=fall, drop_at_s=drop, fault=fault, fault_at_s=at_s, seed=args.seed)
 
 
 def config_from_args(args: argparse.Namespace) -> EmulatorConfig:
@@ -335,6 +336,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "else 200; Protocol 2.0 only): its readings follow a gentle sway of the torso")
     p.add_argument("--imu-fall-at-s", type=float, metavar="S", help="--imu: the torso falls forwards from S "
                    "seconds after the first packet (120 deg/s until flat)")
+    p.add_argument("--imu-drop-at-s", type=float, metavar="S", help="--imu: the robot falls freely from S seconds "
+                   "after the first packet (level; the accelerometer reads 0 g: the feet's load lost)")
     p.add_argument("--imu-fault", metavar="KIND[@S]", help="--imu: from S seconds (default 1) the IMU is "
                    f"{'|'.join(IMU_FAULTS)} (docs/feedback.md says what a walk does then)")
     return p

@@ -219,6 +219,8 @@ def _report(args, config, walk: PlannedWalk, result, sim, port: str, clock, heal
         if feedback is not None:
             sim.extra["feedback_servo_error_deg"] = round(feedback.servo_error_deg, 3)
             sim.extra["feedback_roll_attitude_gain"] = round(config.imu.roll_gain(feedback.servo_error_deg), 4)
+            least = feedback.least_load_g  # the walk's margin to [fall] load_lost_g (docs/feedback.md, "A fall")
+            sim.extra["imu_least_load_g"] = None if least is None else round(least, 3)
         sim.extra["fall_noticed"] = fall_dict(result, sim.tilt_crossed_s(config.imu.fall_tilt_deg))
     if sim is not None and args.json:
         return _sim_exit(_sim_report(sim, True, result.outcome, args.video), result.exit_code)

@@ -3,7 +3,8 @@
 Its control table is gaitbot.servos.opencr's; its readings follow a scripted motion of the torso (a sway
 of ``sway_deg`` at ``sway_hz`` in roll and pitch, the gyro the angles' derivative, the accelerometer gravity
 seen from the tilted torso), and from ``fall_at_s`` a fall: the pitch grows at ``fall_rate_dps`` until it lies
-flat. ``fault`` (from ``fault_at_s``): "frozen" (the registers stop changing), "noisy" (100 deg/s of gyro
+flat; from ``drop_at_s`` a drop: the robot falls freely, level, and the accelerometer reads 0 g (the feet's
+load lost). ``fault`` (from ``fault_at_s``): "frozen" (the registers stop changing), "noisy" (100 deg/s of gyro
 noise) or "absent" (no answer). Kept apart from the emulator (gaitbot.emulator hands it the packets
 addressed to its id) so that it can move with the emulator.
 """
@@ -28,6 +29,7 @@ class ImuDevice:
     sway_hz: float = 0.8
     fall_at_s: float | None = None
     fall_rate_dps: float = 120.0
+    drop_at_s: float | None = None
     fault: str | None = None
     fault_at_s: float = 1.0
     seed: int = 0
@@ -50,6 +52,8 @@ class ImuDevice:
             pitch_rate = self.fall_rate_dps if pitch < 90.0 else 0.0
         r, p = math.radians(roll), math.radians(pitch)
         acc = [-math.sin(p), math.cos(p) * math.sin(r), math.cos(p) * math.cos(r)]
+        if self.drop_at_s is not None and t_s > self.drop_at_s:
+            acc = [0.0, 0.0, 0.0]  # falling freely: nothing but gravity acts, which an accelerometer does not feel
         return [roll_rate, pitch_rate, 0.0], acc, [roll, pitch, 0.0]
 
     def update(self, now_s: float) -> None:

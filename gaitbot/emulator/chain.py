@@ -260,8 +260,10 @@ class EmulatedChain(FaultInjection, HeatAndSupply, ScriptedHand, MoreInstruction
         self._log_goals(raw, frame)
 
     def _imu_answer(self, frame: wire.Frame) -> None:
-        """The IMU device's status packet, on the line after what is already on it (its Return Delay Time is 0)."""
-        packet = self.config.imu.answer(frame, self.now_s)
+        """The IMU device's status packet, on the line after what is already on it (its Return Delay Time is 0).
+        Its scripted motion, fall and fault run on the time since the line's first packet, as --imu-fall-at-s
+        and --imu-fault say (the pty's clock is the host's monotonic one)."""
+        packet = self.config.imu.answer(frame, self.now_s - self.first_packet_s)
         if packet is None:
             return
         send_s = max(self.now_s, self._busy_until_s)

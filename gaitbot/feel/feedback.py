@@ -19,13 +19,17 @@ allow from the last two goals sent: position limits, |step| <= max velocity x fr
 max acceleration x frame^2. So no feedback can break a limit (``gaitbot check`` of the recording holds it).
 
 A fall: the estimated tilt beyond ``[fall] tilt_deg``, or the tilt rate beyond ``tilt_rate_dps`` while the
-tilt is past half the threshold (a push's jolt alone is not a fall): RobotFell, which the session answers
-by stopping the steps, lowering the CoM (``fall_pose``) and the config's response.
+tilt is past half the threshold (a push's jolt alone is not a fall), or the feet's load lost: the
+accelerometer's magnitude (the specific force: 1 g while the feet carry the robot, 0 g falling freely) under
+``load_lost_g`` in every reading for ``load_lost_s`` (a drop, a floor that gives way, a step off an edge:
+nothing tilts, yet nothing holds the robot up). RobotFell, which the session answers by stopping the steps,
+lowering the CoM (``fall_pose``) and the config's response.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Callable
 
 import numpy as np
@@ -38,6 +42,11 @@ from gaitbot.robot.config import RobotConfig
 MODES = ("none", "gyro", "full", "step", "zmp")
 FALL_CROUCH_DEG = {"knee_pitch": 25.0, "hip_pitch": 12.5, "ankle_pitch": 12.5}
 """How much further the legs fold when a fall is noticed (the CoM comes down: less height to fall from)."""
+LOADED_G = 0.7
+"""The feet's load counts as lost only after a reading of at least this (g) has shown them carrying the robot:
+an IMU's registers read 0 g before its first measurement, which is not a fall."""
+DOWN_TILT_DEG = 10.0
+"""A load-lost fall with the torso tilted less than this is said to go "down", not the way it leans."""
 
 
 def servo_stiffness_deg(config: RobotConfig) -> float:
@@ -97,6 +106,10 @@ class Feedback:
         self.correction_rad = np.zeros(len(joints))
         self.fresh = False
         self.reading = None  # the last sense()'s reading (None: missed), for whoever watches the walk
+        self.load_window = max(1, round(s.fall_load_lost_s / period_s))  # readings the load must stay lost
+        self.recent_g: deque[float] = deque(maxlen=self.load_window)  # the accelerometer's last magnitudes (g)
+        self.loaded = False  # a reading of LOADED_G or more seen
+        self.least_load_g: float | None = None  # the lowest magnitude held over a whole window: the margin
 
     @property
     def active(self) -> bool:
@@ -111,6 +124,17 @@ class Feedback:
         self.reading = reading
         if reading is not None:
             self.estimate.update(reading)
+            self._track_load(math.sqrt(sum(float(a) * float(a) for a in reading.acc_g)))
+
+    def _track_load(self, magnitude_g: float) -> None:
+        """The accelerometer's magnitude kept for the load-lost test, once the feet have carried the robot."""
+        self.loaded = self.loaded or magnitude_g >= LOADED_G
+        if not self.loaded:
+            return
+        self.recent_g.append(magnitude_g)
+        if len(self.recent_g) == self.load_window:
+            held = max(self.recent_g)
+            self.least_load_g = held if self.least_load_g is None else min(self.least_load_g, held)
 
     def correct(self, k: int, row) -> np.ndarray:
         """Frame ``k``'s planned goals (ticks) corrected and kept inside every limit; RobotFell on a fall."""
@@ -145,13 +169,17 @@ class Feedback:
     def _check_fall(self) -> None:
         s, e = self.settings, self.estimate
         tilt, rate = e.tilt_deg, float(np.hypot(*e.rates_dps[:2]))
-        reason = None
+        reason, direction = None, e.direction()
         if tilt > s.fall_tilt_deg:
             reason = f"torso tilted {tilt:.0f} deg, beyond {s.fall_tilt_deg:g}"
         elif rate > s.fall_tilt_rate_dps and tilt > 0.5 * s.fall_tilt_deg:
             reason = f"tilting at {rate:.0f} deg/s, beyond {s.fall_tilt_rate_dps:g}, at {tilt:.0f} deg"
+        elif len(self.recent_g) == self.load_window and max(self.recent_g) < s.fall_load_lost_g:
+            reason = (f"the feet's load lost: the accelerometer under {s.fall_load_lost_g:g} g for "
+                      f"{1e3 * self.load_window * e.period_s:.0f} ms, {max(self.recent_g):.2f} g at most")
+            direction = "down" if tilt < DOWN_TILT_DEG else direction
         if reason is not None:
-            raise RobotFell(self.now() - self.start_s, e.direction(), reason)
+            raise RobotFell(self.now() - self.start_s, direction, reason)
 
     def fall_pose(self, last_ticks) -> np.ndarray:
         """The last goals with the legs folded by FALL_CROUCH_DEG, inside the position limits."""

@@ -23,6 +23,8 @@
     [fall]
     tilt_deg = 40.0            # estimated torso tilt beyond this is a fall
     tilt_rate_dps = 250.0      # or a tilt rate beyond this
+    load_lost_g = 0.3          # or the accelerometer under this (g) for load_lost_s: the feet's load lost
+    load_lost_s = 0.05
     response = "torque_off"    # after stopping and lowering the CoM: "hold" or "torque_off"
 
 docs/robot-config.md and docs/feedback.md say what each does; gaitbot.feel applies them.
@@ -42,7 +44,7 @@ FEEDBACK_KEYS = ("ankle_pitch_s", "hip_pitch_s", "ankle_roll_s", "hip_roll_s", "
                  "max_correction_deg", "attitude_roll_gain_by_servo_error")
 MAX_GAIN_POINTS = 16
 MAX_ATTITUDE_GAIN = 2.0
-FALL_KEYS = ("tilt_deg", "tilt_rate_dps", "response")
+FALL_KEYS = ("tilt_deg", "tilt_rate_dps", "load_lost_g", "load_lost_s", "response")
 MAX_DELAY_FRAMES = 30
 MAX_GAIN_S = 1.0
 
@@ -70,6 +72,8 @@ class ImuSettings:
     fall_tilt_rate_dps: float = 250.0
     fall_response: str = "torque_off"
     attitude_roll_gain_by_servo_error: tuple[tuple[float, float], ...] = ()
+    fall_load_lost_g: float = 0.3
+    fall_load_lost_s: float = 0.05
 
     def roll_gain(self, servo_error_deg: float) -> float:
         """The attitude roll gain for servos that give full torque at ``servo_error_deg`` of position error:
@@ -135,7 +139,10 @@ def read_imu(fields: Any, data: dict, bus: Any) -> ImuSettings:
                        fields.number(fall, "tilt_deg", "fall", positive=True, default=40.0, within=(5.0, 90.0, "deg")),
                        fields.number(fall, "tilt_rate_dps", "fall", positive=True, default=250.0,
                                      within=(10.0, 2000.0, "deg/s")),
-                       response, by_error)
+                       response, by_error,
+                       fields.number(fall, "load_lost_g", "fall", positive=True, default=0.3, within=(0.05, 0.9, "g")),
+                       fields.number(fall, "load_lost_s", "fall", positive=True, default=0.05,
+                                     within=(0.01, 1.0, "s")))
 
 
 def _gain_table(fields: Any, feedback: dict) -> tuple[tuple[float, float], ...]:

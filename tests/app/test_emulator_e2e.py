@@ -45,11 +45,11 @@ def scs_config(tmp_path: Path) -> Path:
     return path
 
 
-def walk_through_emulator(config_path: Path, workdir: Path, walk_args: list[str], faults=None):
+def walk_through_emulator(config_path: Path, workdir: Path, walk_args: list[str], faults=None, imu=None):
     """(process, emulator goal ticks, driver recording path, seconds) of one walk on the emulator's pty."""
     workdir.mkdir(parents=True, exist_ok=True)
     emu_log, record = workdir / "emulator-goals.jsonl", workdir / "walk.jsonl"
-    with emulator_for(config_path, emu_log, faults) as emulator:
+    with emulator_for(config_path, emu_log, faults, imu=imu) as emulator:
         start = time.monotonic()
         proc = gaitbot("walk", "--robot", str(config_path), *walk_args, "--port", emulator.path,
                        "--record", str(record))
@@ -167,3 +167,21 @@ def test_extra_latency_within_the_timeout_is_tolerated(tmp_path):
                                                                     SHORT + ["--reply-timeout-ms", "250"], faults)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     np.testing.assert_array_equal(emulator_ticks, dry_run_ticks(CONFIGS["feetech-sts"], tmp_path, SHORT))
+
+
+def test_a_robot_dropped_mid_walk_is_noticed_by_its_imu_and_stops_with_exit_1(tmp_path):
+    """The OpenCR on the line reads 0 g from 2 s after the first packet (the emulator's --imu-drop-at-s): the
+    walk notices the feet's load lost within a few frames, says it fell down, exits 1, and its recording
+    (the goals up to the drop and the fall stop) passes gaitbot check."""
+    from gaitbot.bus.imu_device import ImuDevice
+
+    op3 = ROOT / "config" / "op3.toml"
+    proc, _, record, _ = walk_through_emulator(op3, tmp_path, SHORT, imu=ImuDevice(drop_at_s=2.0))
+    assert proc.returncode == 1, proc.stderr
+    fell = re.search(r"The robot fell down at ([0-9.]+) s \(the feet's load lost: the accelerometer under 0.3 g for "
+                     r"50 ms", proc.stdout)
+    assert fell, proc.stdout
+    # the session's clock starts a little after the line's first packet (the scan): the drop at 2 s on the
+    # device's clock, noticed at its third 0 g reading, is said within half a second of 2 s either way
+    assert 1.5 < float(fell.group(1)) < 2.5
+    assert gaitbot("check", str(record)).returncode == 0

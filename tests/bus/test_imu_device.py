@@ -20,8 +20,11 @@ def read_packet(device_id: int = 200) -> bytes:
 
 
 def chain(imu: ImuDevice) -> EmulatedChain:
+    """The op3's line with the device, its first packet (a READ of the IMU) at t = 0: the device's time."""
     cfg = config("op3")
-    return EmulatedChain(EmulatorConfig("dynamixel", 2.0, cfg.models_by_id, baudrate=2_000_000, imu=imu))
+    line = EmulatedChain(EmulatorConfig("dynamixel", 2.0, cfg.models_by_id, baudrate=2_000_000, imu=imu))
+    ask(line, 0.0)
+    return line
 
 
 def ask(line: EmulatedChain, t_s: float) -> list[bytes]:
@@ -52,3 +55,27 @@ def test_an_absent_imu_does_not_answer_and_a_frozen_one_repeats_itself():
     first, later = ask(line, 1.2), ask(line, 1.7)
     assert first == later
     assert ask(chain(ImuDevice()), 1.2) != ask(chain(ImuDevice()), 1.7)
+
+
+def test_a_dropped_robot_reads_zero_g_from_the_drop_on():
+    """Falling freely, an accelerometer feels nothing (gravity acts on its proof mass as on its case): the
+    accelerometer's three int16 registers read 0 from drop_at_s on, and about 1 g (16384) on z before."""
+    for t_s, falling in ((0.9, False), (1.1, True), (4.0, True)):
+        packet_id, _, params = parse_packet(ask(chain(ImuDevice(drop_at_s=1.0)), t_s)[0], 2.0)
+        acc = struct.unpack("<3h", params[7:13])
+        assert (acc == (0, 0, 0)) if falling else (0.99 * 16384 < acc[2] <= 16384)
+
+
+def test_the_scripted_times_count_from_the_lines_first_packet_not_the_hosts_clock():
+    """On the pty the emulator's clock is the host's monotonic one (hours, not zero, at the first packet): a
+    fall scripted at 1 s is still upright half a second after the first packet and falling 2 s after it."""
+    cfg = config("op3")
+    line = EmulatedChain(EmulatorConfig("dynamixel", 2.0, cfg.models_by_id, baudrate=2_000_000,
+                                        imu=ImuDevice(fall_at_s=1.0)))
+    boot_s = 12_345.0
+    pitch_deg = []
+    for t_s in (boot_s, boot_s + 0.5, boot_s + 2.0):
+        params = parse_packet(ask(line, t_s)[0], 2.0)[2]
+        pitch_deg.append(struct.unpack("<9h", params[1:])[7] / 10)
+    assert abs(pitch_deg[0]) < 3 and abs(pitch_deg[1]) < 3  # the sway only (2 deg at most, halved in pitch)
+    assert pitch_deg[2] > 80  # 120 deg/s for 1 s: lying flat (90 deg) or nearly

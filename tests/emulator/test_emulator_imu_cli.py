@@ -40,6 +40,7 @@ def test_absent_imu_stops_answering_and_no_imu_without_the_switch():
     assert imu_block(line, 0.5) is not None and imu_block(line, 1.5) is None  # absent from the default 1 s
     assert config_of("--robot", "op3").imu is None
     assert config_of("--robot", "op3", "--imu", "--imu-fall-at-s", "3").imu.fall_at_s == 3.0
+    assert config_of("--robot", "op3", "--imu", "--imu-drop-at-s", "2.5").imu.drop_at_s == 2.5
 
 
 @pytest.mark.parametrize("argv, words", [
@@ -47,6 +48,8 @@ def test_absent_imu_stops_answering_and_no_imu_without_the_switch():
     (["--robot", "op3", "--imu", "--imu-fault", "wobbly"], "KIND is one of"),
     (["--robot", "op3", "--imu", "--imu-fault", "noisy@soon"], "S must be a number"),
     (["--robot", "op3", "--imu", "--imu-fall-at-s", "-1"], "--imu-fall-at-s"),
+    (["--robot", "op3", "--imu", "--imu-drop-at-s", "nan"], "--imu-drop-at-s must be within"),
+    (["--robot", "op3", "--imu-drop-at-s", "2"], "need --imu"),
     (["--protocol", "dxl1", "--imu"], "Protocol 2.0 only"),
     (["--protocol", "dxl2", "--ids", "199-200", "--imu"], "id 200 is a servo's"),
 ])

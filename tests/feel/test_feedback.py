@@ -187,6 +187,54 @@ def test_a_tilt_beyond_the_threshold_is_a_fall_with_its_direction():
     assert fell.value.direction == "sideways (left)" and fell.value.t_s == pytest.approx(1.25)
 
 
+def feed(fb, now, readings, row):
+    """Each reading sensed and the frame corrected, a frame apart (RobotFell propagates)."""
+    for r in readings:
+        now[0] += PERIOD_S
+        fb.stub.next = r
+        fb.sense(now[0])
+        fb.correct(0, row)
+
+
+@pytest.mark.parametrize("before, low, fell", [
+    ([1.0] * 10, [0.2, 0.1, 0.0], True),     # loaded, then three readings (50 ms) under 0.3 g: dropped
+    ([1.0] * 10, [0.2, 0.1, 1.0], False),    # two low readings then the feet carry it again: a jolt, not a fall
+    ([1.0] * 10, [0.35] * 30, False),        # half a second at 0.35 g: light, but never under the threshold
+    ([0.0] * 10, [0.0] * 3, False),          # an IMU's registers before its first measurement: never loaded
+])
+def test_the_feet_load_lost_is_a_fall_said_to_go_down(before, low, fell):
+    """The accelerometer's magnitude under [fall] load_lost_g (0.3) in every reading for load_lost_s (0.05 s:
+    3 readings at 60 Hz), once a reading showed the feet carrying the robot (docs/feedback.md, "A fall")."""
+    cfg = config("op3")
+    assert (cfg.imu.fall_load_lost_g, cfg.imu.fall_load_lost_s) == (0.3, 0.05)
+    now = [0.0]
+    fb = Feedback(cfg, "none", StubReader(), PERIOD_S, lambda: now[0])
+    fb.stub = fb.reader
+    row = angles_to_ticks(cfg, np.zeros(len(cfg.joints)))
+    feed(fb, now, [reading([0.0] * 3, [0.0, 0.0, g]) for g in before], row)
+    if not fell:
+        feed(fb, now, [reading([0.0] * 3, [0.0, 0.0, g]) for g in low], row)
+        return
+    with pytest.raises(RobotFell) as raised:
+        feed(fb, now, [reading([0.0] * 3, [0.0, 0.0, g]) for g in low], row)
+    assert raised.value.direction == "down" and "the feet's load lost" in raised.value.reason
+    assert raised.value.t_s == pytest.approx((len(before) + len(low)) * PERIOD_S)  # at the third low reading
+    assert fb.least_load_g == pytest.approx(max(low))
+
+
+def test_the_least_load_held_is_the_lowest_window_maximum():
+    """``least_load_g``: the lowest accelerometer magnitude held over a whole load_lost_s window (the walk's
+    margin to the threshold), computed here by hand over sliding windows of 3."""
+    cfg = config("op3")
+    now = [0.0]
+    fb = Feedback(cfg, "none", StubReader(), PERIOD_S, lambda: now[0])
+    fb.stub = fb.reader
+    row = angles_to_ticks(cfg, np.zeros(len(cfg.joints)))
+    magnitudes = [1.0, 0.9, 0.5, 0.45, 0.8, 1.2, 0.6, 0.55, 0.7, 1.0]
+    feed(fb, now, [reading([0.0] * 3, [0.6 * g, 0.0, 0.8 * g]) for g in magnitudes], row)  # |(0.6, 0, 0.8)| = 1
+    assert fb.least_load_g == pytest.approx(min(max(magnitudes[i:i + 3]) for i in range(len(magnitudes) - 2)))
+
+
 def test_without_a_reading_nothing_is_corrected():
     cfg = strong_op3()
     stub = StubReader()

@@ -1,5 +1,5 @@
-"""``[feedback] attitude_roll_gain_by_servo_error`` in a robot config: read as written, bad ones refused in one
-line naming the field and what is allowed."""
+"""``[feedback] attitude_roll_gain_by_servo_error`` and ``[fall] load_lost_*`` in a robot config: read as
+written, bad ones refused in one line naming the field and what is allowed."""
 
 from __future__ import annotations
 
@@ -42,3 +42,29 @@ def test_a_bad_table_is_refused_naming_the_field(tmp_path, replacement):
 def test_a_flat_gain_still_works_without_the_table(tmp_path):
     cfg = op3_with(tmp_path, "attitude_roll_gain = 0.3")
     assert cfg.imu.roll_gain(6.0) == cfg.imu.roll_gain(13.0) == 0.3
+
+
+def op3_fall_with(tmp_path, old: str, new: str):
+    text = (REPO / "config" / "op3.toml").read_text()
+    assert text.count(old) == 1
+    path = tmp_path / "op3.toml"
+    path.write_text(text.replace(old, new))
+    return load_robot_config(path)
+
+
+def test_the_load_lost_thresholds_are_read_as_written():
+    imu = load_robot_config(REPO / "config" / "op3.toml").imu
+    assert (imu.fall_load_lost_g, imu.fall_load_lost_s) == (0.3, 0.05)
+
+
+@pytest.mark.parametrize("old, new, field", [
+    ("load_lost_g = 0.3", "load_lost_g = 1.5", "fall.load_lost_g"),     # over 0.9 g: a standing robot's reading
+    ("load_lost_g = 0.3", "load_lost_g = 0.0", "fall.load_lost_g"),     # no reading is under 0 g: 0.05 at least
+    ("load_lost_s = 0.05", "load_lost_s = 5.0", "fall.load_lost_s"),    # 5 s of falling: the floor first
+    ("load_lost_s = 0.05", 'load_lost_s = "soon"', "fall.load_lost_s"),
+])
+def test_a_bad_load_lost_threshold_is_refused_naming_the_field(tmp_path, old, new, field):
+    with pytest.raises(FieldError) as caught:
+        op3_fall_with(tmp_path, old, new)
+    message = str(caught.value)
+    assert field in message and "\n" not in message

@@ -144,3 +144,29 @@ def test_the_yardstick_is_the_true_tilt_not_the_hypot_of_roll_and_pitch():
     walk = SimWalk.__new__(SimWalk)
     walk.meter = Meter()
     assert walk.tilt_crossed_s(42.0) == 2.0
+
+
+def test_a_floor_that_gives_way_is_the_feet_load_lost_noticed_within_100_ms(monkeypatch, tmp_path, capsys):
+    """When the push would start, the floor stops holding anything up (its contacts switched off): the robot
+    falls freely and level, which no tilt threshold sees. The accelerometer reads about 0 g, and the walk
+    notices the feet's load lost ([fall] load_lost_g 0.3 held for 50 ms) within 100 ms of the floor going:
+    it says it fell down, exits 1, and its recording passes gaitbot check."""
+    from gaitbot.sim import walk as sim_walk
+
+    gone_s = []
+
+    def floor_gives_way(self, robot) -> None:
+        if robot.time_s + 1e-9 >= self.push.start_s and not gone_s:
+            floor = robot.floor_geom
+            robot.model.geom_contype[floor] = robot.model.geom_conaffinity[floor] = 0
+            gone_s.append(robot.time_s)
+
+    monkeypatch.setattr(sim_walk.Pusher, "__call__", floor_gives_way)
+    record = tmp_path / "drop.jsonl"
+    code, out, err = run_cli(capsys, "walk", "--sim", "--json", "--robot", "op3", "--distance", "0.6",
+                             "--push", "0.1", "--record", record)
+    assert code == 1, err
+    fall = json.loads(out)["fall_noticed"]
+    assert fall["direction"] == "down" and fall["reason"].startswith("the feet's load lost")
+    assert 0 < fall["t_s"] - gone_s[0] <= 0.1
+    assert run_cli(capsys, "check", record)[0] == 0
