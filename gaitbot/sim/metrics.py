@@ -137,6 +137,7 @@ class SimReport:
     max_foothold_error_m: float | None = None
     push: dict | None = None
     heading_deg: float = 0.0  # the torso's yaw change over the run, unwrapped (a steered walk's full turn: 360)
+    self_contacts: tuple[dict, ...] = ()  # the robot's own bodies that touched: names, first time (s), frames
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -173,6 +174,10 @@ class SimReport:
             where = (f"mid-swing of step {step} ({leg} foot swinging)" if phase is None else
                      f"{phase:g} of the way through step {step} (0: the {leg} foot lifts; 1: the next foot lifts)")
             text += f"\nPushed {self.push['impulse_n_s']:+.2f} N s {way} at {self.push['start_s']:.2f} s, {where}."
+        if self.self_contacts:
+            pairs = "; ".join(f"{' and '.join(c['bodies'])} ({c['frames']} frames from {c['first_s']:.2f} s)"
+                              for c in self.self_contacts)
+            text += f"\nThe robot's own bodies touched: {pairs}."
         return text
 
     def _stiffness(self) -> str:
@@ -218,6 +223,7 @@ class WalkMeter:
         self._pending = sorted(plan.heel_strikes, key=lambda h: h.t_s) if plan is not None else []
         self._slip_run = np.zeros(len(SIDES))
         self._last_pose: list[tuple[np.ndarray, np.ndarray] | None] = [None] * len(SIDES)
+        self._self_touch: dict[tuple[int, int], list] = {}  # body pair -> [first time s, frames]
 
     def __call__(self, robot: SimRobot) -> None:
         effort, touched = robot.effort_peak.copy(), robot.touch_steps.copy()
@@ -240,6 +246,8 @@ class WalkMeter:
         self.tracking_deg.append(math.degrees(float(error.max())))
         self.stiffness_deg = tuple(float(e) for e in robot.full_torque_error_deg)
         contacts = robot.floor_contacts()
+        for pair in robot.self_contacts():
+            self._self_touch.setdefault(pair, [t, 0])[1] += 1
         self._check_fall(robot, t, torso, contacts)
         self._measure_slip(robot, contacts)
         self._measure_strikes(robot, t)
@@ -328,7 +336,10 @@ class WalkMeter:
             torso_roll_rms_deg=roll[0], torso_roll_max_deg=roll[1], torso_pitch_rms_deg=pitch[0],
             torso_pitch_max_deg=pitch[1], heel_strikes=tuple(self.strikes),
             max_foothold_error_m=max(errors) if errors else None, push=push,
-            heading_deg=float(np.degrees(np.unwrap(np.radians(rpy[:, 2])))[-1]) if len(rpy) else 0.0)
+            heading_deg=float(np.degrees(np.unwrap(np.radians(rpy[:, 2])))[-1]) if len(rpy) else 0.0,
+            self_contacts=tuple({"bodies": [self.robot.model.body(b).name or f"body {b}" for b in pair],
+                                 "first_s": round(first_s, 4), "frames": frames}
+                                for pair, (first_s, frames) in sorted(self._self_touch.items())))
 
     def _scuff_fraction(self, times: np.ndarray, plan: WalkPlan) -> float:
         """Touching time over window time; a sample at t covers the frame (t - frame, t]."""

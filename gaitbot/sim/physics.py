@@ -197,6 +197,18 @@ class SimRobot:
         np.maximum(self.effort_peak, np.maximum(hi, -lo) / self.stall_nm, out=self.effort_peak)
         self.steps += count
 
+    def self_contacts(self) -> set[tuple[int, int]]:
+        """The pairs of the robot's own bodies (body ids, lower first) in contact now: a knee on a knee, a sole on
+        the other ankle. gaitbot's own models collide the soles with the floor only; another author's may not."""
+        data, body = self.data, self.model.geom_bodyid
+        out = set()
+        for i in range(data.ncon):
+            contact = data.contact[i]
+            b1, b2 = int(body[contact.geom1]), int(body[contact.geom2])
+            if b1 and b2 and contact.dist <= 0.0:  # body 0 is the world: the floor's
+                out.add((min(b1, b2), max(b1, b2)))
+        return out
+
     def floor_contacts(self) -> list[tuple[int, np.ndarray]]:
         """Every contact with the floor now: (geom id of the robot's geom, contact point (3,) world)."""
         data, floor = self.data, self.floor_geom

@@ -173,3 +173,29 @@ def test_a_frame_holds_whole_physics_steps_a_rounded_timestep_included(timestep_
     from gaitbot.sim.foreign import substeps_per_frame
 
     assert substeps_per_frame(1 / 60, timestep_s) == steps
+
+
+def test_the_models_own_bodies_touching_each_other_are_reported(menagerie_xml, tmp_path, capsys):
+    """Another author's model may collide links that gaitbot's own models never do (Menagerie's OP3 has a
+    collision mesh on every link). The stripped model collides its soles only, which the plan keeps 10 mm or
+    more apart: nothing of it touches itself. Give each shank a capsule 36 mm in radius about its leg's line
+    (35 mm from the middle: the two overlap by 2 mm) and the report names that pair, from the walk's start."""
+    import re
+
+    plain = run_cli(capsys, "walk", "--sim", "--json", "--robot", "op3", "--sim-model", menagerie_xml,
+                    "--sim-map", MAP, "--distance", "0.1")
+    assert plain[0] == 0 and json.loads(plain[1])["self_contacts"] == []
+    fat = tmp_path / "fat-shanks.xml"
+    fat.write_text(re.sub(r'(<joint name="([lr])_knee" axis="[^"]*"/>)',
+                          lambda m: m.group(1) + '<geom type="capsule" fromto="0 {0} -0.03 0 {0} -0.08" size="0.036" '
+                          'mass="0"/>'.format(-0.019 if m.group(2) == "l" else 0.019),
+                          menagerie_xml.read_text()))
+    code, out, err = run_cli(capsys, "walk", "--sim", "--json", "--robot", "op3", "--sim-model", fat, "--sim-map", MAP,
+                             "--distance", "0.1")
+    report = json.loads(out)
+    touched = report["self_contacts"]
+    assert [c["bodies"] for c in touched] == [["l_knee_link", "r_knee_link"]], touched
+    assert touched[0]["first_s"] < report["heel_strikes"][0]["t_s"] and touched[0]["frames"] > 10  # before a step
+    code, out, err = run_cli(capsys, "walk", "--sim", "--robot", "op3", "--sim-model", fat, "--sim-map", MAP,
+                             "--distance", "0.1")
+    assert "The robot's own bodies touched: l_knee_link and r_knee_link (" in out
