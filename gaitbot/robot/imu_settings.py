@@ -23,7 +23,7 @@
     [fall]
     tilt_deg = 40.0            # estimated torso tilt beyond this is a fall
     tilt_rate_dps = 250.0      # or a tilt rate beyond this
-    load_lost_g = 0.3          # or the accelerometer under this (g) for load_lost_s: the feet's load lost
+    load_lost_g = 0.2          # or the accelerometer under this (g) for load_lost_s: the feet's load lost
     load_lost_s = 0.05
     response = "torque_off"    # after stopping and lowering the CoM: "hold" or "torque_off"
 
@@ -72,7 +72,7 @@ class ImuSettings:
     fall_tilt_rate_dps: float = 250.0
     fall_response: str = "torque_off"
     attitude_roll_gain_by_servo_error: tuple[tuple[float, float], ...] = ()
-    fall_load_lost_g: float = 0.3
+    fall_load_lost_g: float = 0.2
     fall_load_lost_s: float = 0.05
 
     def roll_gain(self, servo_error_deg: float) -> float:
@@ -140,7 +140,7 @@ def read_imu(fields: Any, data: dict, bus: Any) -> ImuSettings:
                        fields.number(fall, "tilt_rate_dps", "fall", positive=True, default=250.0,
                                      within=(10.0, 2000.0, "deg/s")),
                        response, by_error,
-                       fields.number(fall, "load_lost_g", "fall", positive=True, default=0.3, within=(0.05, 0.9, "g")),
+                       fields.number(fall, "load_lost_g", "fall", positive=True, default=0.2, within=(0.05, 0.9, "g")),
                        fields.number(fall, "load_lost_s", "fall", positive=True, default=0.05,
                                      within=(0.01, 1.0, "s")))
 

@@ -178,7 +178,7 @@ def test_a_robot_dropped_mid_walk_is_noticed_by_its_imu_and_stops_with_exit_1(tm
     op3 = ROOT / "config" / "op3.toml"
     proc, _, record, _ = walk_through_emulator(op3, tmp_path, SHORT, imu=ImuDevice(drop_at_s=2.0))
     assert proc.returncode == 1, proc.stderr
-    fell = re.search(r"The robot fell down at ([0-9.]+) s \(the feet's load lost: the accelerometer under 0.3 g for "
+    fell = re.search(r"The robot fell down at ([0-9.]+) s \(the feet's load lost: the accelerometer under 0.2 g for "
                      r"50 ms", proc.stdout)
     assert fell, proc.stdout
     # the session's clock starts a little after the line's first packet (the scan): the drop at 2 s on the

@@ -197,16 +197,16 @@ def feed(fb, now, readings, row):
 
 
 @pytest.mark.parametrize("before, low, fell", [
-    ([1.0] * 10, [0.2, 0.1, 0.0], True),     # loaded, then three readings (50 ms) under 0.3 g: dropped
-    ([1.0] * 10, [0.2, 0.1, 1.0], False),    # two low readings then the feet carry it again: a jolt, not a fall
-    ([1.0] * 10, [0.35] * 30, False),        # half a second at 0.35 g: light, but never under the threshold
+    ([1.0] * 10, [0.15, 0.1, 0.0], True),    # loaded, then three readings (50 ms) under 0.2 g: dropped
+    ([1.0] * 10, [0.15, 0.1, 1.0], False),    # two low readings then the feet carry it again: a jolt, not a fall
+    ([1.0] * 10, [0.25] * 30, False),        # half a second at 0.25 g: light, but never under the threshold
     ([0.0] * 10, [0.0] * 3, False),          # an IMU's registers before its first measurement: never loaded
 ])
 def test_the_feet_load_lost_is_a_fall_said_to_go_down(before, low, fell):
-    """The accelerometer's magnitude under [fall] load_lost_g (0.3) in every reading for load_lost_s (0.05 s:
+    """The accelerometer's magnitude under [fall] load_lost_g (0.2) in every reading for load_lost_s (0.05 s:
     3 readings at 60 Hz), once a reading showed the feet carrying the robot (docs/feedback.md, "A fall")."""
     cfg = config("op3")
-    assert (cfg.imu.fall_load_lost_g, cfg.imu.fall_load_lost_s) == (0.3, 0.05)
+    assert (cfg.imu.fall_load_lost_g, cfg.imu.fall_load_lost_s) == (0.2, 0.05)
     now = [0.0]
     fb = Feedback(cfg, "none", StubReader(), PERIOD_S, lambda: now[0])
     fb.stub = fb.reader
