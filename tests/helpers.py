@@ -24,7 +24,9 @@ import numpy as np
 import pytest
 
 from gaitbot.app.cli import main
+from gaitbot.check.trajectory import check_trajectory
 from gaitbot.errors import UserError
+from gaitbot.robot.calibration import ticks_to_angles
 from gaitbot.robot.config import load_robot_config, resolve_config
 from gaitbot.servos import wire
 
@@ -71,6 +73,24 @@ def emulator_for(config_path: Path, log_path: Path, faults=None, model_numbers=N
         robot.bus.backend, robot.bus.protocol, robot.models_by_id, robot.bus.baudrate, faults or se.Faults(),
         str(log_path), robot.name, {j.name: j.id for j in robot.joints}, model_numbers=dict(model_numbers or {}),
         imu=imu))
+
+
+def grid_limit_errors(config, ticks: np.ndarray, from_frame: int) -> list[str]:
+    """Joint limits of the goal frames from ``from_frame - 2`` on, one period apart (the session's grid)."""
+    start = max(0, from_frame - 2)
+    angles = np.degrees(ticks_to_angles(config, ticks[start:]))
+    t = np.arange(len(angles)) / config.gait.rate_hz
+    report = check_trajectory(config, t, angles)
+    # one tick of rounding in each frame is what no integer goal can avoid
+    slack = {"velocity": config.gait.rate_hz, "acceleration": 2 * config.gait.rate_hz ** 2}
+    errors = []
+    for v in report.errors:
+        joint = next(j for j in config.joints if j.name == v.joint)
+        tick_deg = 360.0 / (2 * np.pi * joint.model.ticks_per_rad)
+        if v.kind in slack and abs(v.value) <= v.limit + slack[v.kind] * tick_deg + 1e-9:
+            continue
+        errors.append(v.describe())
+    return errors
 
 
 # --- recordings

@@ -254,7 +254,7 @@ def speed_fit_note(plan: BalancedPlan) -> str | None:
     b, g = fit.balance, fit.gait
     settings = (f"crouch {b.crouch_knee_deg:g} deg, double support {100 * b.double_support_share:g}%, progression "
                 f"done at {100 * b.progression_end:g}% of the swing, clearance {1000 * g.clearance_m:g} mm"
-                + (" (as --clearance asked: kept, not lowered)" if g.clearance_asked else ""))
+                + (" (as --clearance asked: kept, not lowered)" if fit.kept_clearance else ""))
     peak = f"peak {fit.peak_dps:.0f} deg/s, {100 * fit.peak_share:.1f}% of a limit"
     # a foot still travelling when it lands lands short (measured: docs/walk-faster.md)
     short = ("; with the foot moving until it lands, steps land short of the plan: a longer --cycle with longer "

@@ -4,7 +4,7 @@ Its control table is gaitbot.servos.opencr's; its readings follow a scripted mot
 of ``sway_deg`` at ``sway_hz`` in roll and pitch, the gyro the angles' derivative, the accelerometer gravity
 seen from the tilted torso), and from ``fall_at_s`` a fall: the pitch grows at ``fall_rate_dps`` until it lies
 flat; from ``drop_at_s`` a drop: the robot falls freely, level, and the accelerometer reads 0 g (the feet's
-load lost). ``fault`` (from ``fault_at_s``): "frozen" (the registers stop changing), "noisy" (100 deg/s of gyro
+load lost) with DROP_NOISE_G of noise, as a real one does. ``fault`` (from ``fault_at_s``): "frozen" (the registers stop changing), "noisy" (100 deg/s of gyro
 noise) or "absent" (no answer). Kept apart from the emulator (gaitbot.emulator hands it the packets
 addressed to its id) so that it can move with the emulator.
 """
@@ -18,6 +18,10 @@ from dataclasses import dataclass
 from gaitbot.servos import opencr, wire
 
 FAULTS = ("frozen", "noisy", "absent")
+DROP_NOISE_G = 0.002
+"""The accelerometer's noise while it falls freely (1 sigma, g: 300 ug/sqrt(Hz), InvenSense's MPU-9250 product
+specification, over the OpenCR's ~40 Hz): 33 LSB, so its registers do not all read 0, which
+gaitbot.feel.feedback takes as a dead sensor."""
 
 
 @dataclass
@@ -64,6 +68,8 @@ class ImuDevice:
         gyro, acc, rpy = self.motion(now_s)
         if faulty and self.fault == "noisy":
             gyro = [g + self.rng.gauss(0.0, 100.0) for g in gyro]
+        if self.drop_at_s is not None and now_s > self.drop_at_s:
+            acc = [a + self.rng.gauss(0.0, DROP_NOISE_G) for a in acc]
         start, length = opencr.IMU_BLOCK
         self.table[start:start + length] = opencr.encode_imu_block(gyro, acc, rpy)
 

@@ -22,7 +22,9 @@ A fall: the estimated tilt beyond ``[fall] tilt_deg``, or the tilt rate beyond `
 tilt is past half the threshold (a push's jolt alone is not a fall), or the feet's load lost: the
 accelerometer's magnitude (the specific force: 1 g while the feet carry the robot, 0 g falling freely) under
 ``load_lost_g`` in every reading for ``load_lost_s`` (a drop, a floor that gives way, a step off an edge:
-nothing tilts, yet nothing holds the robot up). RobotFell, which the session answers by stopping the steps,
+nothing tilts, yet nothing holds the robot up). The window is whole readings, at least two, covering at least
+``load_lost_s``; a missed reading starts it again, and a reading of exactly 0 on all three axes is no reading
+(a dead accelerometer, or one not yet measuring: a falling one's noise still moves its low bits). RobotFell, which the session answers by stopping the steps,
 lowering the CoM (``fall_pose``) and the config's response.
 """
 
@@ -43,8 +45,8 @@ MODES = ("none", "gyro", "full", "step", "zmp")
 FALL_CROUCH_DEG = {"knee_pitch": 25.0, "hip_pitch": 12.5, "ankle_pitch": 12.5}
 """How much further the legs fold when a fall is noticed (the CoM comes down: less height to fall from)."""
 LOADED_G = 0.7
-"""The feet's load counts as lost only after a reading of at least this (g) has shown them carrying the robot:
-an IMU's registers read 0 g before its first measurement, which is not a fall."""
+"""The feet's load counts as lost only after a reading of at least this (g) has shown them carrying the robot
+(a walk starts standing on them); [fall] load_lost_g stays under it (gaitbot.robot.imu_settings)."""
 DOWN_TILT_DEG = 10.0
 """A load-lost fall with the torso tilted less than this is said to go "down", not the way it leans."""
 
@@ -106,7 +108,7 @@ class Feedback:
         self.correction_rad = np.zeros(len(joints))
         self.fresh = False
         self.reading = None  # the last sense()'s reading (None: missed), for whoever watches the walk
-        self.load_window = max(1, round(s.fall_load_lost_s / period_s))  # readings the load must stay lost
+        self.load_window = max(2, math.ceil(s.fall_load_lost_s / period_s - 1e-9))  # readings it must stay lost
         self.recent_g: deque[float] = deque(maxlen=self.load_window)  # the accelerometer's last magnitudes (g)
         self.loaded = False  # a reading of LOADED_G or more seen
         self.least_load_g: float | None = None  # the lowest magnitude held over a whole window: the margin
@@ -124,10 +126,15 @@ class Feedback:
         self.reading = reading
         if reading is not None:
             self.estimate.update(reading)
-            self._track_load(math.sqrt(sum(float(a) * float(a) for a in reading.acc_g)))
+        self._track_load(reading)
 
-    def _track_load(self, magnitude_g: float) -> None:
-        """The accelerometer's magnitude kept for the load-lost test, once the feet have carried the robot."""
+    def _track_load(self, reading) -> None:
+        """The accelerometer's magnitude kept for the load-lost test (module docstring), once the feet have
+        carried the robot; a missed or all-zero reading starts the window again."""
+        magnitude_g = 0.0 if reading is None else math.sqrt(sum(float(a) * float(a) for a in reading.acc_g))
+        if magnitude_g == 0.0:
+            self.recent_g.clear()
+            return
         self.loaded = self.loaded or magnitude_g >= LOADED_G
         if not self.loaded:
             return

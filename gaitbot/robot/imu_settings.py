@@ -140,7 +140,7 @@ def read_imu(fields: Any, data: dict, bus: Any) -> ImuSettings:
                        fields.number(fall, "tilt_rate_dps", "fall", positive=True, default=250.0,
                                      within=(10.0, 2000.0, "deg/s")),
                        response, by_error,
-                       fields.number(fall, "load_lost_g", "fall", positive=True, default=0.2, within=(0.05, 0.9, "g")),
+                       fields.number(fall, "load_lost_g", "fall", positive=True, default=0.2, within=(0.05, 0.5, "g")),
                        fields.number(fall, "load_lost_s", "fall", positive=True, default=0.05,
                                      within=(0.01, 1.0, "s")))
 

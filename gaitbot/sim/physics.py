@@ -199,13 +199,15 @@ class SimRobot:
 
     def self_contacts(self) -> set[tuple[int, int]]:
         """The pairs of the robot's own bodies (body ids, lower first) in contact now: a knee on a knee, a sole on
-        the other ankle. gaitbot's own models collide the soles with the floor only; another author's may not."""
-        data, body = self.data, self.model.geom_bodyid
+        the other ankle. gaitbot's own models collide the soles with the floor only; another author's may not.
+        The robot's bodies are those of the torso's tree (a scene's props and floor are not)."""
+        data, body, root = self.data, self.model.geom_bodyid, self.model.body_rootid
+        robot = root[self.torso_body]
         out = set()
         for i in range(data.ncon):
             contact = data.contact[i]
             b1, b2 = int(body[contact.geom1]), int(body[contact.geom2])
-            if b1 and b2 and contact.dist <= 0.0:  # body 0 is the world: the floor's
+            if root[b1] == robot and root[b2] == robot and contact.dist <= 0.0:
                 out.add((min(b1, b2), max(b1, b2)))
         return out
 

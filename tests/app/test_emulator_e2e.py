@@ -22,7 +22,7 @@ from gaitbot.bus.recording import decode_goal_frames
 from gaitbot.robot.config import load_robot_config
 
 import gaitbot.emulator as se  # noqa: E402 - the emulator, imported as a module
-from helpers import REPO_ROOT, emulator_for, gaitbot, slow_except
+from helpers import REPO_ROOT, emulator_for, gaitbot, grid_limit_errors, slow_except
 
 ROOT = REPO_ROOT
 CONFIGS = {"dxl2": ROOT / "config" / "xl430-biped.toml", "dxl1": ROOT / "config" / "ax12a-biped.toml",
@@ -172,7 +172,7 @@ def test_extra_latency_within_the_timeout_is_tolerated(tmp_path):
 def test_a_robot_dropped_mid_walk_is_noticed_by_its_imu_and_stops_with_exit_1(tmp_path):
     """The OpenCR on the line reads 0 g from 2 s after the first packet (the emulator's --imu-drop-at-s): the
     walk notices the feet's load lost within a few frames, says it fell down, exits 1, and its recording
-    (the goals up to the drop and the fall stop) passes gaitbot check."""
+    (the goals up to the drop and the fall stop) keeps every joint limit."""
     from gaitbot.bus.imu_device import ImuDevice
 
     op3 = ROOT / "config" / "op3.toml"
@@ -184,4 +184,6 @@ def test_a_robot_dropped_mid_walk_is_noticed_by_its_imu_and_stops_with_exit_1(tm
     # the session's clock starts a little after the line's first packet (the scan): the drop at 2 s on the
     # device's clock, noticed at its third 0 g reading, is said within half a second of 2 s either way
     assert 1.5 < float(fell.group(1)) < 2.5
-    assert gaitbot("check", str(record)).returncode == 0
+    # every goal sent, the fall stop's included, within the joints' limits on the session's frame grid (gaitbot
+    # check times them by their send times, which a busy test machine jitters: tests/app/test_faults_emulator.py)
+    assert grid_limit_errors(load_robot_config(op3), decode_goal_frames(record)[2], 0) == []

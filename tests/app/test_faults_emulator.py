@@ -21,10 +21,8 @@ import pytest
 
 import gaitbot.emulator as se
 from gaitbot.bus.recording import decode_goal_frames
-from gaitbot.check.trajectory import check_trajectory
-from gaitbot.robot.calibration import ticks_to_angles
 from gaitbot.robot.config import load_robot_config
-from helpers import CONFIG_DIR, emulator_for, gaitbot, slow_except
+from helpers import CONFIG_DIR, emulator_for, gaitbot, grid_limit_errors, slow_except
 
 FAULT_FRAME = 120
 #: the servo each scenario hurts: ankle_pitch_left (id 3) on xl430 and sts3215, knee_pitch_left (13) on ax12a
@@ -49,24 +47,6 @@ SCENARIOS = [scenario("xl430-biped", kind) for kind in ("late", "silent", "overl
     scenario("sts3215-biped", "overload")]
 #: The quick loop keeps one fault's stop ramp; the full run every robot and fault.
 SCENARIOS = slow_except(SCENARIOS, "xl430-biped-overload-mid-walk")
-
-
-def grid_limit_errors(config, ticks: np.ndarray, from_frame: int) -> list[str]:
-    """Joint limits of the goal frames from ``from_frame - 2`` on, one period apart (the session's grid)."""
-    start = max(0, from_frame - 2)
-    angles = np.degrees(ticks_to_angles(config, ticks[start:]))
-    t = np.arange(len(angles)) / config.gait.rate_hz
-    report = check_trajectory(config, t, angles)
-    # one tick of rounding in each frame is what no integer goal can avoid
-    slack = {"velocity": config.gait.rate_hz, "acceleration": 2 * config.gait.rate_hz ** 2}
-    errors = []
-    for v in report.errors:
-        joint = next(j for j in config.joints if j.name == v.joint)
-        tick_deg = 360.0 / (2 * np.pi * joint.model.ticks_per_rad)
-        if v.kind in slack and abs(v.value) <= v.limit + slack[v.kind] * tick_deg + 1e-9:
-            continue
-        errors.append(v.describe())
-    return errors
 
 
 @pytest.mark.parametrize("robot, kind, faults, mid_walk", SCENARIOS)

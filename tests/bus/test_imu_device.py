@@ -58,12 +58,16 @@ def test_an_absent_imu_does_not_answer_and_a_frozen_one_repeats_itself():
 
 
 def test_a_dropped_robot_reads_zero_g_from_the_drop_on():
-    """Falling freely, an accelerometer feels nothing (gravity acts on its proof mass as on its case): the
-    accelerometer's three int16 registers read 0 from drop_at_s on, and about 1 g (16384) on z before."""
+    """Falling freely, an accelerometer feels nothing (gravity acts on its proof mass as on its case): from
+    drop_at_s on, the three int16 registers read 0 g within the sensor's noise (0.002 g: 33 LSB; 5 sigma
+    here), not all exactly 0 (a dead sensor's reading); about 1 g (16384) on z before."""
     for t_s, falling in ((0.9, False), (1.1, True), (4.0, True)):
         packet_id, _, params = parse_packet(ask(chain(ImuDevice(drop_at_s=1.0)), t_s)[0], 2.0)
         acc = struct.unpack("<3h", params[7:13])
-        assert (acc == (0, 0, 0)) if falling else (0.99 * 16384 < acc[2] <= 16384)
+        if falling:
+            assert max(abs(a) for a in acc) < 5 * 33 and acc != (0, 0, 0)
+        else:
+            assert 0.99 * 16384 < acc[2] <= 16384
 
 
 def test_the_scripted_times_count_from_the_lines_first_packet_not_the_hosts_clock():

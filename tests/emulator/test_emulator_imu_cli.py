@@ -29,15 +29,17 @@ def test_imu_on_the_op3_line_answers_at_its_config_id_and_freezes_when_told():
     config = config_of("--robot", "op3", "--imu", "--imu-fault", "frozen@2")
     assert config.imu.device_id == 200 and config.imu.fault == "frozen" and config.imu.fault_at_s == 2.0
     line = EmulatedChain(config)
+    imu_block(line, 0.0)  # the line's first packet: the device's time starts here
     early, later = imu_block(line, 0.5), imu_block(line, 1.1)
     assert early is not None and len(early) == 18 and early != later  # the sway moves the readings
-    frozen = imu_block(line, 2.2)
-    assert imu_block(line, 3.7) == frozen  # frozen: the registers stop changing
+    # frozen from 2 s: the registers keep what the last read before then (1.1 s) found, and stop changing
+    assert imu_block(line, 2.2) == later and imu_block(line, 3.7) == later
 
 
 def test_absent_imu_stops_answering_and_no_imu_without_the_switch():
     line = EmulatedChain(config_of("--robot", "op3", "--imu", "--imu-fault", "absent"))
-    assert imu_block(line, 0.5) is not None and imu_block(line, 1.5) is None  # absent from the default 1 s
+    assert imu_block(line, 0.0) is not None and imu_block(line, 0.5) is not None
+    assert imu_block(line, 1.5) is None  # absent from the default 1 s after the first packet
     assert config_of("--robot", "op3").imu is None
     assert config_of("--robot", "op3", "--imu", "--imu-fall-at-s", "3").imu.fall_at_s == 3.0
     assert config_of("--robot", "op3", "--imu", "--imu-drop-at-s", "2.5").imu.drop_at_s == 2.5

@@ -187,20 +187,27 @@ def test_a_tilt_beyond_the_threshold_is_a_fall_with_its_direction():
     assert fell.value.direction == "sideways (left)" and fell.value.t_s == pytest.approx(1.25)
 
 
-def feed(fb, now, readings, row):
-    """Each reading sensed and the frame corrected, a frame apart (RobotFell propagates)."""
+def feed(fb, now, readings, row, period_s=PERIOD_S):
+    """Each reading (None: a missed read) sensed and the frame corrected, a frame apart (RobotFell propagates)."""
     for r in readings:
-        now[0] += PERIOD_S
+        now[0] += period_s
         fb.stub.next = r
         fb.sense(now[0])
         fb.correct(0, row)
 
 
+def level(*g):
+    return [None if v is None else reading([0.0] * 3, [0.0, 0.0, v]) for v in g]
+
+
 @pytest.mark.parametrize("before, low, fell", [
-    ([1.0] * 10, [0.15, 0.1, 0.0], True),    # loaded, then three readings (50 ms) under 0.2 g: dropped
+    ([1.0] * 10, [0.15, 0.1, 0.05], True),    # loaded, then three readings (50 ms) under 0.2 g: dropped
     ([1.0] * 10, [0.15, 0.1, 1.0], False),    # two low readings then the feet carry it again: a jolt, not a fall
-    ([1.0] * 10, [0.25] * 30, False),        # half a second at 0.25 g: light, but never under the threshold
-    ([0.0] * 10, [0.0] * 3, False),          # an IMU's registers before its first measurement: never loaded
+    ([1.0] * 10, [0.25] * 30, False),         # half a second at 0.25 g: light, but never under the threshold
+    ([0.0] * 10, [0.1] * 3, False),           # an IMU's registers before its first measurement: never loaded
+    ([1.0] * 10, [0.0] * 30, False),          # exactly 0 on all three axes: a dead accelerometer, not a drop
+    ([1.0] * 10, [0.1, 0.1, None, 0.1, 0.1], False),  # a missed read: the 50 ms were not all seen
+    ([1.0] * 10, [0.1, 0.1, None, 0.1, 0.1, 0.1], True),  # ... then three readings in a row again
 ])
 def test_the_feet_load_lost_is_a_fall_said_to_go_down(before, low, fell):
     """The accelerometer's magnitude under [fall] load_lost_g (0.2) in every reading for load_lost_s (0.05 s:
@@ -211,15 +218,32 @@ def test_the_feet_load_lost_is_a_fall_said_to_go_down(before, low, fell):
     fb = Feedback(cfg, "none", StubReader(), PERIOD_S, lambda: now[0])
     fb.stub = fb.reader
     row = angles_to_ticks(cfg, np.zeros(len(cfg.joints)))
-    feed(fb, now, [reading([0.0] * 3, [0.0, 0.0, g]) for g in before], row)
+    feed(fb, now, level(*before), row)
     if not fell:
-        feed(fb, now, [reading([0.0] * 3, [0.0, 0.0, g]) for g in low], row)
+        feed(fb, now, level(*low), row)
         return
     with pytest.raises(RobotFell) as raised:
-        feed(fb, now, [reading([0.0] * 3, [0.0, 0.0, g]) for g in low], row)
+        feed(fb, now, level(*low), row)
     assert raised.value.direction == "down" and "the feet's load lost" in raised.value.reason
-    assert raised.value.t_s == pytest.approx((len(before) + len(low)) * PERIOD_S)  # at the third low reading
-    assert fb.least_load_g == pytest.approx(max(low))
+    assert raised.value.t_s == pytest.approx((len(before) + len(low)) * PERIOD_S)  # at the last low reading
+    assert fb.least_load_g == pytest.approx(max(g for g in low[-3:]))
+
+
+@pytest.mark.parametrize("rate_hz, readings", [(60.0, 3), (50.0, 3), (20.0, 2), (10.0, 2)])
+def test_the_load_lost_window_covers_load_lost_s_in_two_readings_at_least(rate_hz, readings):
+    """The window is whole readings covering at least load_lost_s (0.05 s): 3 at 60 Hz (exactly 50 ms), 3 at
+    50 Hz (2.5 rounded up: 60 ms), and never one reading alone, however slow the frames (2 at 20 and 10 Hz)."""
+    cfg = config("op3")
+    now = [0.0]
+    period_s = 1.0 / rate_hz
+    fb = Feedback(cfg, "none", StubReader(), period_s, lambda: now[0])
+    fb.stub = fb.reader
+    row = angles_to_ticks(cfg, np.zeros(len(cfg.joints)))
+    feed(fb, now, level(1.0, 1.0), row, period_s)
+    feed(fb, now, level(*[0.1] * (readings - 1)), row, period_s)  # one reading short: no fall yet
+    with pytest.raises(RobotFell) as raised:
+        feed(fb, now, level(0.1), row, period_s)
+    assert f"under 0.2 g for {1e3 * readings * period_s:.0f} ms" in raised.value.reason  # the span it covered
 
 
 def test_the_least_load_held_is_the_lowest_window_maximum():

@@ -52,13 +52,14 @@ def op3_fall_with(tmp_path, old: str, new: str):
     return load_robot_config(path)
 
 
-def test_the_load_lost_thresholds_are_read_as_written():
-    imu = load_robot_config(REPO / "config" / "op3.toml").imu
-    assert (imu.fall_load_lost_g, imu.fall_load_lost_s) == (0.2, 0.05)
+def test_the_load_lost_thresholds_are_read_as_written(tmp_path):
+    imu = op3_fall_with(tmp_path, "load_lost_g = 0.2\nload_lost_s = 0.05", "load_lost_g = 0.15\nload_lost_s = 0.1").imu
+    assert (imu.fall_load_lost_g, imu.fall_load_lost_s) == (0.15, 0.1)
 
 
 @pytest.mark.parametrize("old, new, field", [
-    ("load_lost_g = 0.2", "load_lost_g = 1.5", "fall.load_lost_g"),     # over 0.9 g: a standing robot's reading
+    ("load_lost_g = 0.2", "load_lost_g = 1.5", "fall.load_lost_g"),     # over 1 g: a standing robot's reading
+    ("load_lost_g = 0.2", "load_lost_g = 0.6", "fall.load_lost_g"),     # over 0.5 g: near a walk's own swings
     ("load_lost_g = 0.2", "load_lost_g = 0.0", "fall.load_lost_g"),     # no reading is under 0 g: 0.05 at least
     ("load_lost_s = 0.05", "load_lost_s = 5.0", "fall.load_lost_s"),    # 5 s of falling: the floor first
     ("load_lost_s = 0.05", 'load_lost_s = "soon"', "fall.load_lost_s"),

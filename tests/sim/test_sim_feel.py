@@ -149,7 +149,7 @@ def test_the_yardstick_is_the_true_tilt_not_the_hypot_of_roll_and_pitch():
 def test_a_floor_that_gives_way_is_the_feet_load_lost_noticed_within_100_ms(monkeypatch, tmp_path, capsys):
     """When the push would start, the floor stops holding anything up (its contacts switched off): the robot
     falls freely and level, which no tilt threshold sees. The accelerometer reads about 0 g, and the walk
-    notices the feet's load lost ([fall] load_lost_g 0.3 held for 50 ms) within 100 ms of the floor going:
+    notices the feet's load lost ([fall] load_lost_g 0.2 held for 50 ms) within 100 ms of the floor going:
     it says it fell down, exits 1, and its recording passes gaitbot check."""
     from gaitbot.sim import walk as sim_walk
 

@@ -57,6 +57,12 @@ class SpeedFit:
     def fits(self) -> bool:
         return self.peak_share <= self.target_share
 
+    @property
+    def kept_clearance(self) -> bool:
+        """The candidate taken would have lowered the clearance, and kept the one the user asked for instead."""
+        lowered = FALLBACKS[self.relaxed - 1][2] if self.relaxed else None
+        return self.gait.clearance_asked and lowered is not None and lowered < self.gait.clearance_m
+
 
 def peak_joint_speed_dps(q_rad, rate_hz: float) -> float:
     return float(np.degrees(np.abs(np.diff(q_rad, axis=0))).max() * rate_hz)
