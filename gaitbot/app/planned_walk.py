@@ -182,12 +182,13 @@ def plan_trajectory_file(request: WalkRequest) -> PlannedWalk:
 
 def plan_steered_walk(request: WalkRequest) -> PlannedWalk:
     """``--velocity``/``--duration`` or ``--commands`` on a robot whose legs roll and turn: the footstep
-    planner's steps walked by the balanced walker (gaitbot.app.steer_walk, docs/steering.md)."""
+    planner's steps walked by the balanced walker (gaitbot.app.steer_walk, docs/steering.md), its servos'
+    speed fitted as a straight walk's (said in the same note)."""
     from gaitbot.app.steer_walk import steered_plan
 
     plan = steered_plan(request.source, request.options)
     return PlannedWalk(request.source, plan.walk.trajectory(goals=True), plan.walk.trajectory(),
-                       tuple(plan.heel_strikes), tuple(plan.planned_steps), plan)
+                       tuple(plan.heel_strikes), tuple(plan.planned_steps), plan, _notes(speed_fit_note(plan)))
 
 
 #: Gait source -> its planner (gait_source_of says which the options ask for).

@@ -113,7 +113,11 @@ def steered_plan_summary(source, plan: SteeredPlan) -> dict:
             "duration_s": float(walk.t_s[-1]), "rate_hz": plan.walker.rate_hz, "steps": steps,
             "commanded": {"x_m": cx, "y_m": cy, "heading_deg": ch},
             "planned": {"x_m": px, "y_m": py, "heading_deg": ph},
-            "clipped": any(f.clipped for f in plan.footsteps)}
+            "clipped": any(f.clipped for f in plan.footsteps),
+            "crouch_knee_deg": plan.fit.balance.crouch_knee_deg,
+            "double_support_share": plan.fit.balance.double_support_share,
+            "progression_end": plan.fit.balance.progression_end, "clearance_m": plan.fit.gait.clearance_m,
+            "peak_joint_speed_dps": plan.fit.peak_dps}
 
 
 def print_steered_plan(summary: dict) -> None:
