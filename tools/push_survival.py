@@ -104,10 +104,7 @@ def markdown(args) -> str:
             row = one_push(args.robot, args.walk, impulse, direction, phase, n, m)
             survived[m].append(row["survived"])
             counts[quarter, 1 + i] += row["survived"]
-            if row["noticed_after_s"] is not None:
-                noticed[m].append(row["noticed_after_s"])
-            if row["survived"] and row["least_load_g"] is not None:
-                least[m].append(row["least_load_g"])
+            tally(row, noticed, least)
     rows = ["| impulse N s | pushes | " + " | ".join(f"survived, feedback {m}" for m in modes) + " |",
             "|---|---|" + "---|" * len(modes)]
     for q in range(4):
@@ -119,6 +116,14 @@ def markdown(args) -> str:
     return (f"<!-- figure {name} -->\n" + "\n".join(rows) + "\n<!-- /figure -->\n"
             f"<!-- figure {name}-by-way -->\n" + by_way(draws, survived, modes) + "\n<!-- /figure -->\n"
             f"<!-- figure {name}-noticed -->\n" + noticed_lines(noticed, least) + "\n<!-- /figure -->")
+
+
+def tally(row: dict, noticed: dict, least: dict) -> None:
+    """A push's row into the lists of noticed_lines: its fall's notice time, or a walk that stood's margin."""
+    if row["noticed_after_s"] is not None:
+        noticed[row["feedback"]].append(row["noticed_after_s"])
+    if row["survived"] and row["least_load_g"] is not None:
+        least[row["feedback"]].append(row["least_load_g"])
 
 
 def noticed_lines(noticed: dict, least: dict) -> str:
@@ -190,10 +195,7 @@ def run(args) -> int:
         rows = [one_push(args.robot, args.walk, impulse, direction, phase, n, m) for m in modes]
         for row in rows:
             survived[row["feedback"]] += row["survived"]
-            if row["noticed_after_s"] is not None:
-                noticed[row["feedback"]].append(row["noticed_after_s"])
-            if row["survived"] and row["least_load_g"] is not None:
-                least[row["feedback"]].append(row["least_load_g"])
+            tally(row, noticed, least)
             if args.json:
                 print(json.dumps(row))
         if not args.json:

@@ -4,9 +4,9 @@ Its control table is gaitbot.servos.opencr's; its readings follow a scripted mot
 of ``sway_deg`` at ``sway_hz`` in roll and pitch, the gyro the angles' derivative, the accelerometer gravity
 seen from the tilted torso), and from ``fall_at_s`` a fall: the pitch grows at ``fall_rate_dps`` until it lies
 flat; from ``drop_at_s`` a drop: the robot falls freely, level, and the accelerometer reads 0 g (the feet's
-load lost) with DROP_NOISE_G of noise, as a real one does. ``fault`` (from ``fault_at_s``): "frozen" (the registers stop changing), "noisy" (100 deg/s of gyro
-noise) or "absent" (no answer). Kept apart from the emulator (gaitbot.emulator hands it the packets
-addressed to its id) so that it can move with the emulator.
+load lost) with DROP_NOISE_G of noise, as a real one does. ``fault`` (from ``fault_at_s``): "frozen" (the
+registers stop changing), "noisy" (100 deg/s of gyro noise) or "absent" (no answer). Kept apart from the
+emulator (gaitbot.emulator hands it the packets addressed to its id) so that it can move with the emulator.
 """
 
 from __future__ import annotations

@@ -38,12 +38,13 @@ class TiltEstimate:
         self.up = (0.0, 0.0, 1.0)  # the world's up in the torso's frame (unit)
         self.roll_deg = self.pitch_deg = 0.0
         self.rates_dps = np.zeros(3)
+        self.acc_norm_g = 0.0  # the last reading's accelerometer magnitude (specific force, g)
         self.started = False
 
     def update(self, reading: ImuReading) -> None:
         self.rates_dps = np.asarray(reading.gyro_dps, dtype=float)
         ax, ay, az = (float(v) for v in reading.acc_g)  # floats: a frame's few dozen operations, no arrays
-        norm = math.sqrt(ax * ax + ay * ay + az * az)
+        self.acc_norm_g = norm = math.sqrt(ax * ax + ay * ay + az * az)
         if not self.started:  # the first reading: the accelerometer's tilt as it is
             x, y, z = (ax, ay, az) if norm > 0.0 else (0.0, 0.0, 1.0)
             self.started = True

@@ -24,8 +24,8 @@ accelerometer's magnitude (the specific force: 1 g while the feet carry the robo
 ``load_lost_g`` in every reading for ``load_lost_s`` (a drop, a floor that gives way, a step off an edge:
 nothing tilts, yet nothing holds the robot up). The window is whole readings, at least two, covering at least
 ``load_lost_s``; a missed reading starts it again, and a reading of exactly 0 on all three axes is no reading
-(a dead accelerometer, or one not yet measuring: a falling one's noise still moves its low bits). RobotFell, which the session answers by stopping the steps,
-lowering the CoM (``fall_pose``) and the config's response.
+(a dead accelerometer, or one not yet measuring: a falling one's noise still moves its low bits). RobotFell,
+which the session answers by stopping the steps, lowering the CoM (``fall_pose``) and the config's response.
 """
 
 from __future__ import annotations
@@ -126,12 +126,11 @@ class Feedback:
         self.reading = reading
         if reading is not None:
             self.estimate.update(reading)
-        self._track_load(reading)
+        self._track_load(0.0 if reading is None else self.estimate.acc_norm_g)
 
-    def _track_load(self, reading) -> None:
-        """The accelerometer's magnitude kept for the load-lost test (module docstring), once the feet have
-        carried the robot; a missed or all-zero reading starts the window again."""
-        magnitude_g = 0.0 if reading is None else math.sqrt(sum(float(a) * float(a) for a in reading.acc_g))
+    def _track_load(self, magnitude_g: float) -> None:
+        """The accelerometer's magnitude (g; 0: a missed reading) kept for the load-lost test (module
+        docstring), once the feet have carried the robot; a missed or all-zero reading starts the window again."""
         if magnitude_g == 0.0:
             self.recent_g.clear()
             return
@@ -181,9 +180,9 @@ class Feedback:
             reason = f"torso tilted {tilt:.0f} deg, beyond {s.fall_tilt_deg:g}"
         elif rate > s.fall_tilt_rate_dps and tilt > 0.5 * s.fall_tilt_deg:
             reason = f"tilting at {rate:.0f} deg/s, beyond {s.fall_tilt_rate_dps:g}, at {tilt:.0f} deg"
-        elif len(self.recent_g) == self.load_window and max(self.recent_g) < s.fall_load_lost_g:
+        elif len(self.recent_g) == self.load_window and (held := max(self.recent_g)) < s.fall_load_lost_g:
             reason = (f"the feet's load lost: the accelerometer under {s.fall_load_lost_g:g} g for "
-                      f"{1e3 * self.load_window * e.period_s:.0f} ms, {max(self.recent_g):.2f} g at most")
+                      f"{1e3 * self.load_window * e.period_s:.0f} ms, {held:.2f} g at most")
             direction = "down" if tilt < DOWN_TILT_DEG else direction
         if reason is not None:
             raise RobotFell(self.now() - self.start_s, direction, reason)

@@ -48,7 +48,8 @@ def test_the_speed_fits_note_says_when_its_steps_will_land_short(args, short, ca
     assert ("steps land short" in notes[0]) == short
 
 
-@pytest.mark.parametrize("walk", [("--distance", "1", "--max-step", "0.06"), ("--velocity", "0.15,0,0", "--duration", "4")])
+@pytest.mark.parametrize("walk", [("--distance", "1", "--max-step", "0.06"),
+                                  ("--velocity", "0.15,0,0", "--duration", "4")])
 def test_an_asked_clearance_is_walked_as_asked_or_refused_naming_it(walk, capsys):
     """The 0.15 m/s walk, straight or steered, needs the speed fit's fallbacks, which lower the op3's own 5 mm
     clearance to 3 mm; a clearance given with --clearance is kept (and the note says so), and one the servos
